@@ -1,0 +1,101 @@
+// voussoir: the command-line program. Parses arguments (CLI11), reads the deck, dispatches to
+// a subcommand in drivers/. Exit status: 0 success, 2 bad deck or arguments, 1 failure
+// during a run (SPEC.md section 2).
+
+#include <omp.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "drivers/commands.hpp"
+#include "drivers/setup.hpp"
+#include "io/deck.hpp"
+#include "voussoir/config.hpp"
+
+namespace {
+
+struct DeckArgs {
+  std::string deck;
+  std::vector<std::string> sets;
+};
+
+// Options every subcommand takes: the deck, --set, --threads, --json, --quiet.
+void add_common(CLI::App* cmd, DeckArgs& deck, voussoir::CommonOptions& common) {
+  cmd->add_option("deck", deck.deck, "input deck (TOML)")->required();
+  cmd->add_option("--set", deck.sets, "override a deck key: --set model.embrace=150 (repeatable)")
+      ->allow_extra_args(false);
+  cmd->add_option("--threads", common.threads, "OpenMP threads (default: all cores)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--json", common.json_path, "write a JSON summary to FILE ('-' for stdout)");
+  cmd->add_flag("-q,--quiet", common.quiet, "no progress on stderr");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"voussoir " VOUSSOIR_VERSION
+               " - collapse capacity of dry-joint masonry arches by FDEM"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", VOUSSOIR_VERSION);
+
+  DeckArgs deck;
+  voussoir::CommonOptions common;
+
+  voussoir::CheckOptions check_opts;
+  CLI::App* check = app.add_subcommand("check", "validate the deck and print the model summary");
+  add_common(check, deck, common);
+  check->add_option("--mesh-out", check_opts.mesh_out, "write the meshed model as JSON");
+
+  voussoir::RunOptions run_opts;
+  CLI::App* run = app.add_subcommand("run", "one simulation: HDF5 output and JSON summary");
+  add_common(run, deck, common);
+  run->add_option("-o,--output", run_opts.output, "HDF5 output file (overrides output.file)");
+
+  voussoir::CapacityOptions cap_opts;
+  CLI::App* capacity =
+      app.add_subcommand("capacity", "collapse load factor lambda* by bisection on lambda");
+  add_common(capacity, deck, common);
+  capacity->add_option("--points", cap_opts.points,
+                       "trial lambdas per bisection round, run in parallel (default 2)")
+      ->check(CLI::Range(1, 64));
+
+  voussoir::SweepOptions sweep_opts;
+  CLI::App* sweep = app.add_subcommand("sweep", "capacity over a grid of deck values");
+  add_common(sweep, deck, common);
+  sweep->add_option("--param", sweep_opts.params, "KEY=V1,V2,... (repeat for a grid)")
+      ->required();
+  sweep->add_option("--csv", sweep_opts.csv, "CSV output (default sweep.csv)");
+  sweep->add_option("--plot", sweep_opts.plot, "PNG plot of lambda* over the grid");
+  sweep->add_option("--points", sweep_opts.points, "trial lambdas per round (default 2)")
+      ->check(CLI::Range(1, 64));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+
+  try {
+    if (common.threads > 0) omp_set_num_threads(common.threads);
+    if (sweep->parsed())
+      return voussoir::command_sweep(deck.deck, deck.sets, common, sweep_opts);
+    const voussoir::Config config = voussoir::load_deck(deck.deck, deck.sets);
+    if (check->parsed()) return voussoir::command_check(config, common, check_opts);
+    if (run->parsed()) return voussoir::command_run(config, common, run_opts);
+    if (capacity->parsed()) return voussoir::command_capacity(config, common, cap_opts);
+  } catch (const voussoir::DeckError& e) {
+    std::fprintf(stderr, "voussoir: error: %s\n", e.what());
+    return 2;
+  } catch (const voussoir::RunError& e) {
+    std::fprintf(stderr, "voussoir: run failed: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "voussoir: run failed: %s\n", e.what());
+    return 1;
+  }
+  return 2;
+}

@@ -1,0 +1,255 @@
+// Contact stage: NBS broad phase (lazy), potential penalty narrow phase, Coulomb friction.
+//
+// Stable time step contribution (max_omega_squared). Model: a boundary edge of length L
+// pressed flat into a partner by a depth d. The overlap is a strip of area L d in the
+// sub-triangles next to the two faces, where |grad phi| = 3/h, so the pair force is
+// Ep thick g L d with g = 3/h_c + 3/h_t. With linear shape functions along the edge the
+// stiffness of the two nodes of the edge is Ep thick g [L/3 L/6; L/6 L/3], coupled with the
+// same matrix (negated) to the partner's nodes; its largest M^-1 K eigenvalue, the uniform
+// mode against the partner, is the Gershgorin row sum Ep thick g L / m (exact for equal
+// masses). A node on several boundary edges adds their rows. Hence, over free nodes i,
+//     omega^2 <= max_i  sum_{boundary edges k at i}  Ep thick (3/h_e(k) + 3/h_min) L_k / m_i
+// with h_e the smallest height of the triangle owning edge k (conservative for slivers, whose
+// gradient next to a short interior edge can be larger than next to the boundary edge) and
+// h_min the smallest such height over all participants (the unknown partner). Friction adds
+// a tangential spring whose row sum stays within the normal one (contact/friction.hpp), in
+// the perpendicular direction, so it does not raise the bound. Corner contacts (a vertex in a
+// face) are softer: the overlap grows like d^2, the stiffness like d. The explicit scheme is
+// stable for dt <= 2 / omega; core combines this with the element bound.
+
+#include "contact/contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "contact/broad_phase.hpp"
+#include "contact/friction.hpp"
+#include "contact/narrow_phase.hpp"
+
+namespace voussoir {
+
+struct ContactSystem::Impl {
+  ContactParams params;
+  double penalty = 0.0;    // Ep [Pa]
+  double thickness = 1.0;  // out-of-plane [m]
+  BroadPhase broad;
+  bool ready = false;
+
+  // Candidate pairs (triangle ids, sorted) and their friction state.
+  std::vector<IndexPair> pairs, next_pairs;
+  std::vector<double> sx, sy, kt, next_sx, next_sy;
+
+  // Per triangle id (participants only): longest boundary edge [m], smallest height [m].
+  std::vector<double> edge_len, height;
+  double min_height = 0.0;
+
+  std::int64_t active = 0;
+  std::int64_t detections = 0;
+
+  template <bool kFriction>
+  void accumulate(Model& model, double dt, EnergyLedger& ledger);
+};
+
+ContactSystem::ContactSystem() : impl_(std::make_unique<Impl>()) {}
+ContactSystem::~ContactSystem() = default;
+ContactSystem::ContactSystem(const ContactSystem& o) : impl_(std::make_unique<Impl>(*o.impl_)) {}
+ContactSystem& ContactSystem::operator=(const ContactSystem& o) {
+  if (this != &o) impl_ = std::make_unique<Impl>(*o.impl_);
+  return *this;
+}
+ContactSystem::ContactSystem(ContactSystem&&) noexcept = default;
+ContactSystem& ContactSystem::operator=(ContactSystem&&) noexcept = default;
+
+void ContactSystem::setup(const Model& model, const ContactParams& params) {
+  Impl& s = *impl_;
+  s.params = params;
+  s.penalty = params.penalty > 0.0 ? params.penalty : 100.0 * model.material.lame_lambda();
+  s.thickness = model.out_of_plane;
+  const Participants parts = select_participants(model);
+  const double buffer = params.buffer > 0.0 ? params.buffer : default_buffer(model, parts);
+  s.broad.setup(model, buffer);
+  s.pairs.clear();
+  s.sx.clear();
+  s.sy.clear();
+  s.kt.clear();
+  s.active = 0;
+  s.detections = 0;
+
+  // Reference geometry of the participants (for k_t and the stable step).
+  const Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  s.edge_len.assign(t.size(), 0.0);
+  s.height.assign(t.size(), 0.0);
+  s.min_height = std::numeric_limits<double>::infinity();
+  for (Index e : parts.tri) {
+    const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
+    double longest = 0.0, longest_boundary = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double len =
+          std::hypot(n.x0[v[(k + 1) % 3]] - n.x0[v[k]], n.y0[v[(k + 1) % 3]] - n.y0[v[k]]);
+      longest = std::max(longest, len);
+      if (t.boundary[e] & (1u << k)) longest_boundary = std::max(longest_boundary, len);
+    }
+    s.edge_len[e] = longest_boundary;
+    s.height[e] = 2.0 * t.area0[e] / longest;
+    s.min_height = std::min(s.min_height, s.height[e]);
+  }
+  s.ready = true;
+}
+
+bool ContactSystem::needs_detection(const Nodes& nodes) const {
+  return impl_->ready && impl_->broad.needs_detection(nodes);
+}
+
+void ContactSystem::detect(const Model& model) {
+  Impl& s = *impl_;
+  if (!s.ready) return;
+  s.broad.detect(model.nodes, s.next_pairs);
+  carry_friction_history(s.pairs, s.sx, s.sy, s.next_pairs, s.next_sx, s.next_sy);
+  std::swap(s.pairs, s.next_pairs);
+  std::swap(s.sx, s.next_sx);
+  std::swap(s.sy, s.next_sy);
+  s.kt.resize(s.pairs.size());
+  const double scale = kTangentialStiffnessRatio * s.penalty * s.thickness;
+  for (std::size_t p = 0; p < s.pairs.size(); ++p) {
+    const Index a = s.pairs[p].a, b = s.pairs[p].b;
+    s.kt[p] =
+        scale * (3.0 / s.height[a] + 3.0 / s.height[b]) * std::min(s.edge_len[a], s.edge_len[b]);
+  }
+  ++s.detections;
+}
+
+template <bool kFriction>
+void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledger) {
+  Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  const double* x = n.x.data();
+  const double* y = n.y.data();
+  const double* vx = n.vx.data();
+  const double* vy = n.vy.data();
+  double* fx = n.fx.data();
+  double* fy = n.fy.data();
+  const Index* tn0 = t.n0.data();
+  const Index* tn1 = t.n1.data();
+  const Index* tn2 = t.n2.data();
+  const double ep = penalty * thickness, mu = params.friction;
+  double energy = 0.0, stored = 0.0, dissipated = 0.0;
+  std::int64_t n_active = 0;
+
+  const std::size_t np = pairs.size();
+  for (std::size_t p = 0; p < np; ++p) {
+    const Index a = pairs[p].a, b = pairs[p].b;
+    const Index c[3] = {tn0[a], tn1[a], tn2[a]};
+    const Index d[3] = {tn0[b], tn1[b], tn2[b]};
+    // Quick rejection on the current (uninflated) boxes.
+    const double cxl = std::min({x[c[0]], x[c[1]], x[c[2]]});
+    const double cxh = std::max({x[c[0]], x[c[1]], x[c[2]]});
+    const double dxl = std::min({x[d[0]], x[d[1]], x[d[2]]});
+    const double dxh = std::max({x[d[0]], x[d[1]], x[d[2]]});
+    const double cyl = std::min({y[c[0]], y[c[1]], y[c[2]]});
+    const double cyh = std::max({y[c[0]], y[c[1]], y[c[2]]});
+    const double dyl = std::min({y[d[0]], y[d[1]], y[d[2]]});
+    const double dyh = std::max({y[d[0]], y[d[1]], y[d[2]]});
+    PairForce f;
+    if (cxl < dxh && dxl < cxh && cyl < dyh && dyl < cyh) {
+      f = triangle_pair_force(
+          {Vec2{x[c[0]], y[c[0]]}, Vec2{x[c[1]], y[c[1]]}, Vec2{x[c[2]], y[c[2]]}},
+          {Vec2{x[d[0]], y[d[0]]}, Vec2{x[d[1]], y[d[1]]}, Vec2{x[d[2]], y[d[2]]}}, ep);
+    }
+    if (!(f.area > 0.0)) {
+      if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
+      continue;
+    }
+    ++n_active;
+    energy += f.energy;
+    for (int k = 0; k < 3; ++k) {
+      fx[c[k]] += f.on_c[k].x;
+      fy[c[k]] += f.on_c[k].y;
+      fx[d[k]] += f.on_t[k].x;
+      fy[d[k]] += f.on_t[k].y;
+    }
+    if constexpr (kFriction) {
+      const auto& wc = f.bary_c;
+      const auto& wt = f.bary_t;
+      const Vec2 du{dt * (wc[0] * vx[c[0]] + wc[1] * vx[c[1]] + wc[2] * vx[c[2]] -
+                          wt[0] * vx[d[0]] - wt[1] * vx[d[1]] - wt[2] * vx[d[2]]),
+                    dt * (wc[0] * vy[c[0]] + wc[1] * vy[c[1]] + wc[2] * vy[c[2]] -
+                          wt[0] * vy[d[0]] - wt[1] * vy[d[1]] - wt[2] * vy[d[2]])};
+      const FrictionResult r = coulomb_friction(f.resultant, du, {sx[p], sy[p]}, kt[p], mu);
+      sx[p] = r.slip.x;
+      sy[p] = r.slip.y;
+      for (int k = 0; k < 3; ++k) {
+        fx[c[k]] += wc[k] * r.force.x;
+        fy[c[k]] += wc[k] * r.force.y;
+        fx[d[k]] -= wt[k] * r.force.x;
+        fy[d[k]] -= wt[k] * r.force.y;
+      }
+      stored += r.stored;
+      dissipated += r.dissipated;
+    }
+  }
+  active = n_active;
+  ledger.contact = energy + stored;
+  if constexpr (kFriction) ledger.friction_dissipated += dissipated;
+}
+
+void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger) {
+  Impl& s = *impl_;
+  if (!s.ready) {
+    ledger.contact = 0.0;
+    return;
+  }
+  // Branch once: with mu = 0 no friction code runs at all.
+  if (s.params.friction > 0.0)
+    s.accumulate<true>(model, dt, ledger);
+  else
+    s.accumulate<false>(model, dt, ledger);
+}
+
+double ContactSystem::max_omega_squared(const Model& model) const {
+  const Impl& s = *impl_;
+  if (!s.ready) return 0.0;
+  const Participants& parts = s.broad.participants();
+  if (parts.size() == 0) return 0.0;
+  const Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  const double ep = s.penalty * s.thickness;
+  // Row sums per free node, accumulated over the boundary edges of the participants.
+  std::vector<double> row(n.size(), 0.0);
+  for (Index i = 0; i < parts.size(); ++i) {
+    if (parts.fixed[i]) continue;
+    const Index e = parts.tri[i];
+    const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
+    const double g = 3.0 / s.height[e] + 3.0 / s.min_height;
+    for (int k = 0; k < 3; ++k) {
+      if (!(t.boundary[e] & (1u << k))) continue;
+      const Index i0 = v[k], i1 = v[(k + 1) % 3];
+      const double len = std::hypot(n.x0[i1] - n.x0[i0], n.y0[i1] - n.y0[i0]);
+      row[i0] += ep * g * len;
+      row[i1] += ep * g * len;
+    }
+  }
+  double w2 = 0.0;
+  for (Index i = 0; i < n.size(); ++i)
+    if (row[i] > 0.0 && n.inv_mass[i] > 0.0) w2 = std::max(w2, row[i] * n.inv_mass[i]);
+  return w2;
+}
+
+std::int64_t ContactSystem::candidate_pairs() const {
+  return static_cast<std::int64_t>(impl_->pairs.size());
+}
+std::int64_t ContactSystem::active_pairs() const {
+  return impl_->active;
+}
+std::int64_t ContactSystem::detections() const {
+  return impl_->detections;
+}
+double ContactSystem::penalty() const {
+  return impl_->penalty;
+}
+double ContactSystem::buffer() const {
+  return impl_->broad.buffer();
+}
+
+}  // namespace voussoir

@@ -1,0 +1,59 @@
+#pragma once
+// Contact between blocks: NBS broad phase (contact/broad_phase), Munjiza potential-based
+// penalty force over triangle overlaps (contact/narrow_phase), Coulomb friction on accumulated
+// slip (contact/friction). This header is the one interface core/step.cpp calls.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/energy.hpp"
+#include "core/model.hpp"
+
+namespace voussoir {
+
+struct ContactParams {
+  double penalty = 0.0;   // Ep [Pa] (normal penalty of the potential contact)
+  double friction = 0.0;  // Coulomb mu; 0 = no friction work at all
+  double buffer = 0.0;    // NBS buffer [m]; 0 = automatic (a fraction of the smallest element)
+};
+
+class ContactSystem {
+ public:
+  // Value semantics: a copy is a deep copy (capacity trials start from copies of one settled
+  // state), including pair lists and friction history.
+  ContactSystem();
+  ~ContactSystem();
+  ContactSystem(const ContactSystem& other);
+  ContactSystem& operator=(const ContactSystem& other);
+  ContactSystem(ContactSystem&&) noexcept;
+  ContactSystem& operator=(ContactSystem&&) noexcept;
+
+  // Chooses the participating triangles (boundary edge, not both fixed), sizes the grid.
+  void setup(const Model& model, const ContactParams& params);
+  // True when some node has moved more than buffer/2 since the last detection.
+  bool needs_detection(const Nodes& nodes) const;
+  // Broad phase: rebuilds the candidate pair list (friction history carried over by key).
+  void detect(const Model& model);
+  // Narrow phase + friction: adds contact forces into nodes.fx/fy, sets ledger.contact and
+  // accumulates ledger.friction_dissipated.
+  void add_forces(Model& model, double dt, EnergyLedger& ledger);
+
+  // Largest effective contact stiffness per unit nodal mass, for the stable time step:
+  // omega_max^2 estimate [1/s2].
+  double max_omega_squared(const Model& model) const;
+
+  std::int64_t candidate_pairs() const;
+  std::int64_t active_pairs() const;  // pairs with nonzero overlap at the last add_forces
+  std::int64_t detections() const;
+
+  // Additions (contact helper):
+  double penalty() const;  // Ep in use [Pa] (ContactParams::penalty, or 100 x Lame lambda if 0)
+  double buffer() const;   // NBS buffer in use [m]
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace voussoir

@@ -1,0 +1,81 @@
+#pragma once
+// Coulomb friction on the accumulated slip of one contact pair (non-associative, elastic
+// predictor / return mapping; SPEC section 1 "Friction").
+//
+// State. Each candidate pair (c, t) carries its elastic tangential displacement s [m] (a 2D
+// vector, so that it survives a rotation of the contact normal). Key: the unordered pair of
+// triangle ids (a < b) -- the narrow phase always evaluates a pair both ways, so there is no
+// direction to tell apart. The state survives re-detection (contact/friction.cpp merges the
+// old sorted pair list into the new one) and is reset to zero whenever the pair has no overlap.
+//
+// Step. n = F_n / |F_n| with F_n the pair's potential (normal) force on c, tangent
+// e = (-n_y, n_x). du = relative displacement of c's material with respect to t's at the
+// overlap centroid over the last step (dt times the half-step velocities interpolated with the
+// shape functions, i.e. x^n - x^(n-1) of the two material points). Then
+//     s_trial = (s . e + du . e),     f_trial = -k_t s_trial                 (elastic predictor)
+//     if |f_trial| <= mu |F_n|:  f = f_trial,          s = s_trial            (stick)
+//     else:                      f = -mu |F_n| sign,   s = mu |F_n| / k_t sign   (slip)
+// The plastic slip |s_trial - s| is dissipated at the capped force: D += mu |F_n| |s_trial - s|.
+// The elastic part 1/2 k_t s^2 is stored energy (booked with the contact energy). f acts on c
+// and -f on t at the same point (overlap centroid), so forces and moments balance exactly.
+//
+// Tangential stiffness. k_t = kTangentialStiffnessRatio x Ep thick (3/h_c + 3/h_t) min(L_c, L_t)
+// [N/m]: the normal stiffness of a flat contact, Ep thick (|grad phi_c| + |grad phi_t|) x
+// contact length, for the longest contact the two triangles can make (L: longest boundary
+// edge, h: smallest height), times 1/2. Constant per pair, so that 1/2 k_t s^2 is an honest
+// energy (a k_t following the overlap length would change the stored energy without work).
+// The ratio 1/2 keeps the tangential row sum of the stiffness (2 k_t N_i <= Ep thick g L)
+// within the normal one, so the stable step from max_omega_squared covers friction too;
+// the elastic slip at stick is f/k_t ~ 1e-10 m for masonry blocks, far below what matters.
+
+#include <cmath>
+#include <vector>
+
+#include "contact/broad_phase.hpp"
+#include "core/model.hpp"
+
+namespace voussoir {
+
+// Tangential / normal penalty stiffness ratio (dimensionless; 0.5, see above).
+inline constexpr double kTangentialStiffnessRatio = 0.5;
+
+struct FrictionResult {
+  Vec2 force;               // tangential force on c [N] (minus this on t)
+  Vec2 slip;                // new elastic slip vector s [m]
+  double dissipated = 0.0;  // energy dissipated this step [J]
+  double stored = 0.0;      // 1/2 k_t |s|^2 [J]
+  bool sliding = false;
+};
+
+// One friction update. normal_force: pair potential force on c [N]; du: relative displacement
+// increment of c w.r.t. t at the contact point [m]; slip: elastic slip s before the step [m];
+// kt [N/m] > 0; mu >= 0.
+inline FrictionResult coulomb_friction(Vec2 normal_force, Vec2 du, Vec2 slip, double kt,
+                                       double mu) {
+  FrictionResult r;
+  const double fn = std::hypot(normal_force.x, normal_force.y);
+  if (!(fn > 0.0)) return r;
+  const double ex = -normal_force.y / fn, ey = normal_force.x / fn;
+  const double s_trial = (slip.x + du.x) * ex + (slip.y + du.y) * ey;
+  const double cap = mu * fn;
+  double s = s_trial, f = -kt * s_trial;
+  if (std::abs(f) > cap) {
+    const double sign = s_trial > 0.0 ? 1.0 : -1.0;
+    f = -cap * sign;
+    s = cap / kt * sign;
+    r.dissipated = cap * std::abs(s_trial - s);
+    r.sliding = true;
+  }
+  r.force = {f * ex, f * ey};
+  r.slip = {s * ex, s * ey};
+  r.stored = 0.5 * kt * s * s;
+  return r;
+}
+
+// Carries the friction state across a re-detection: for every pair of `next` (sorted) that
+// was also in `prev` (sorted), copies its slip; new pairs start at zero. Linear merge.
+void carry_friction_history(const std::vector<IndexPair>& prev, const std::vector<double>& prev_sx,
+                            const std::vector<double>& prev_sy, const std::vector<IndexPair>& next,
+                            std::vector<double>& next_sx, std::vector<double>& next_sy);
+
+}  // namespace voussoir

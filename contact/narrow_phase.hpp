@@ -1,0 +1,80 @@
+#pragma once
+// Narrow phase: Munjiza's potential-based penalty contact between two triangles.
+//
+// Potential. Every triangle T carries phi_T(x) = 3 min_k lambda_k(x), lambda_k its barycentric
+// coordinates (linear shape functions N_k). phi_T = 1 at the centroid, 0 on the edges, and on
+// the sub-triangle R_k(T) = (centroid, edge opposite vertex m) -- where lambda_m is the
+// smallest coordinate -- it is linear, phi_T = 3 lambda_m, with the constant gradient
+//     g_m(T) = 3 grad lambda_m = 3 n_m / h_m          (n_m inward unit normal, h_m height).
+//
+// Energy. For the pair (c, t) with overlap P = c n t, per unit thickness,
+//     E = Ep  integral_P (phi_c + phi_t) dA                                         [J/m]
+// (Munjiza 2004, ch. 2: each triangle's material sits in the other's potential field; the
+// pair is always evaluated both ways, so there is no contactor/target asymmetry.)
+//
+// Force (exact gradient of E). Take the half E_t = Ep int_P phi_t dA: the material of c moving
+// in the field of t. phi_t vanishes on t's edges, so only c's motion and t's field matter:
+//  - node j of t moves the field: d lambda_m / d X_j = -lambda_j grad lambda_m, hence
+//        f_j(t) = -dE_t/dX_j = +Ep int_P N_j^t grad phi_t dA;
+//  - node i of c moves the material of c (Reynolds transport with the affine velocity N_i^c):
+//        f_i(c) = -dE_t/dx_i = -Ep int_P (N_i^c grad phi_t + phi_t grad N_i^c) dA.
+// Summing both halves, the resultant on c is Munjiza's
+//     F_c = Ep int_P (grad phi_c - grad phi_t) dA = -F_t,
+// the force on c pushes it out of t (grad phi_t points into t). The forces -g dA on c and
+// +g dA on t act at the same point x, so with linear N the pair's forces sum to zero and their
+// moments cancel exactly. The "area change" term phi_t grad N_i^c (absent from the classical
+// distribution) has zero resultant (sum_i grad N_i = 0) and zero moment
+// (sum_i x_i (x) grad N_i = I is symmetric); it only makes the nodal forces the exact gradient
+// of E when c deforms, which closes the energy balance.
+//
+// Evaluation (exact, no quadrature). P is obtained by clipping t against c's three edges
+// (Sutherland-Hodgman, convex, at most 6 vertices). For each field triangle T in {c, t}, P is
+// split into the three regions P n R_m(T) by the lines lambda_a = lambda_b (through the
+// centroid); on each region the gradient is constant and every integrand is affine, so only
+// the area A and first moments (Sx, Sy) of each region are needed (shoelace formulas):
+//     int N dA = alpha A + beta Sx + gamma Sy      for N = alpha + beta x + gamma y.
+// With G_T = sum_m g_m(T) (A, Sx, Sy)_m (a 2x3 matrix) and Phi_T = int_P phi_T dA:
+//     f_i(c) = Ep [ (G_c - G_t) l_i^c - Phi_t grad N_i^c ],
+//     f_j(t) = Ep [ (G_t - G_c) l_j^t - Phi_c grad N_j^t ],   E = Ep (Phi_c + Phi_t),
+// l = (alpha, beta, gamma) the shape-function coefficients. Coordinates are shifted to a local
+// origin (c's first vertex) first: overlaps at rest are ~1e-10 m deep and absolute coordinates
+// would cancel catastrophically in the shoelace sums.
+//
+// Point of action. The forces on c have resultant F and moment M = sum (x F_y - y F_x) about
+// the origin (the area-change term contributes neither); their line of action is
+// {x : x F_y - y F_x = M}. We report the point of that line nearest the overlap centroid C0:
+//     x_F = C0 + (M - C0 x F) / |F|^2 (F_y, -F_x)         (C0 if F = 0).
+//
+// Rejected: the edge-wise boundary integral of Munjiza's book (integrate phi_c along t's
+// edges and vice versa) gives the same resultant but distributes it along the edges, which is
+// not the gradient of E above; it also needs the same polygon clipping.
+//
+// Units: Ep in Pa, multiplied by the out-of-plane thickness [m] before calling (the kernel
+// takes `penalty` = Ep x thickness [N/m2]); forces N, energy J, area m2.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "contact/broad_phase.hpp"
+#include "core/model.hpp"
+
+namespace voussoir {
+
+struct PairForce {
+  std::array<Vec2, 3> on_c{}, on_t{};        // nodal forces on c and on t [N]
+  Vec2 resultant;                            // total force on c (= minus total on t) [N]
+  double area = 0.0;                         // overlap area [m2]
+  double energy = 0.0;                       // penalty energy Ep thick int (phi_c + phi_t) dA [J]
+  Vec2 point;                                // point of action of the resultant [m]
+  Vec2 centroid;                             // overlap centroid [m]
+  std::array<double, 3> bary_c{}, bary_t{};  // shape functions of c and t at the centroid
+};
+
+// Contact between triangles c and t (vertices counter-clockwise, current positions).
+// `penalty` = Ep x out-of-plane thickness [N/m2]. Zero forces and area when they do not
+// overlap; zero everything if either triangle is inverted or degenerate.
+PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec2, 3>& t,
+                              double penalty);
+
+}  // namespace voussoir

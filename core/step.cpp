@@ -1,0 +1,137 @@
+// One explicit step: the stages of core/step.hpp in order, plus the set-up of the per-step
+// context and the stable time step.
+
+#include "core/step.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+
+#include "core/cst.hpp"
+#include "core/integrate.hpp"
+#include "core/loads.hpp"
+
+namespace voussoir {
+
+namespace {
+
+// Accumulates wall-clock time into StageTimers fields; free when timers are disabled.
+class StageClock {
+ public:
+  explicit StageClock(bool enabled) : enabled_(enabled) {
+    if (enabled_) last_ = std::chrono::steady_clock::now();
+  }
+  void stamp(double& seconds) {
+    if (!enabled_) return;
+    const auto now = std::chrono::steady_clock::now();
+    seconds += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  bool enabled_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+CstLaw law_of(const StepContext& ctx) {
+  return CstLaw{ctx.lame_lambda, ctx.shear_modulus, ctx.eta};
+}
+
+}  // namespace
+
+// eta = damping_factor x 2 h sqrt(E rho), h the smallest triangle height of the free blocks
+// (SPEC section 1): the critical viscosity of the shortest element mode in Munjiza's scaling.
+void prepare_context(Simulation& sim, double damping_factor) {
+  const Material& mat = sim.model.material;
+  sim.ctx.lame_lambda = mat.lame_lambda_2d();
+  sim.ctx.shear_modulus = mat.shear_modulus();
+  const double h = min_triangle_height(sim.model);
+  sim.ctx.eta =
+      std::isfinite(h) ? damping_factor * 2.0 * h * std::sqrt(mat.young * mat.density) : 0.0;
+}
+
+// Stable step = 2 / (g + sqrt(omega^2 + g^2)) (core/cst.hpp damped_stable_step) with
+//   omega^2 = max_e omega_e^2 + omega_contact^2,  g = max_e (c/m)_e / 2.
+// The element terms are rigorous upper bounds (element eigenvalue theorem, cst.hpp). Contact
+// springs act on the same nodes as the elements, so their stiffnesses add: the sum of the two
+// omega^2 bounds the combined system, whereas the smaller of the two separate limits
+// (min(2/omega_el, 2/omega_c)) can exceed the true limit by up to sqrt(2).
+double stable_time_step(const Simulation& sim) {
+  const CstFrequencyBound el = max_frequency_bound(sim.model, law_of(sim.ctx));
+  double omega_squared = el.omega_squared;
+  if (sim.ctx.contact_on) omega_squared += sim.contact.max_omega_squared(sim.model);
+  if (!(omega_squared > 0.0) && !(el.damping_rate > 0.0))
+    return std::numeric_limits<double>::infinity();
+  return damped_stable_step(omega_squared, el.damping_rate);
+}
+
+void advance(Simulation& sim) {
+  Model& model = sim.model;
+  StepContext& ctx = sim.ctx;
+  EnergyLedger& ledger = sim.ledger;
+  StageTimers& timers = sim.timers;
+  StageClock clock(timers.enabled);
+  const bool first = sim.step == 0;
+
+  // 1. broad phase, only when some node moved more than the buffer allows
+  if (ctx.contact_on && sim.contact.needs_detection(model.nodes)) sim.contact.detect(model);
+  clock.stamp(timers.broad);
+
+  // 2. clear forces
+  clear_forces(model.nodes);
+
+  // 3. element forces (CST + Munjiza damping at the half-step velocities)
+  const CstLaw law = law_of(ctx);
+  if (law.eta > 0.0) {
+    sim.viscous_piola.resize(4 * std::size_t(model.tris.size()), 0.0);  // once
+  } else {
+    sim.viscous_piola.clear();
+  }
+  const ElementStageResult el =
+      add_element_forces(model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr);
+  clock.stamp(timers.elements);
+
+  // 4. contact forces (sets ledger.contact, accumulates friction dissipation)
+  if (ctx.contact_on) {
+    sim.contact.add_forces(model, ctx.dt, ledger);
+  } else {
+    ledger.contact = 0.0;
+  }
+  clock.stamp(timers.contact);
+
+  // 5. body loads; the momentum before the update gives the exact external work
+  const Vec2 momentum = add_body_loads(model, ctx.body_ax, ctx.body_ay);
+  clock.stamp(timers.loads);
+
+  // 6. central difference: v then x
+  const double kinetic = integrate_central_difference(model, ctx.dt);
+  clock.stamp(timers.integrate);
+
+  // Energy ledger.
+  ledger.kinetic = kinetic;
+  ledger.strain = el.strain_energy;
+  // Work over the last position increment x^n - x^(n-1) = dt v^(n-1/2), by the trapezoid
+  // 1/2 (f^n + f^(n-1)) that makes the leapfrog ledger exact (core/integrate.hpp):
+  //   body load:  dt/2 (a^n + a^(n-1)) . sum m v^(n-1/2)                     (core/loads.hpp)
+  //   damping:    -dt/2 (f_v^n + f_v^(n-1)) . v^(n-1/2)
+  //             =  dt/2 (sum V0 J eta D:D + sum V0 P_v^(n-1) : Fdot(v^(n-1/2)))
+  // (the second sum uses the viscous stress kept from the previous step). At the first step
+  // there is no such increment and the initial state's energy is booked as input instead.
+  if (first) {
+    ledger.external_work += ledger.stored();
+  } else {
+    ledger.external_work += 0.5 * ctx.dt *
+                            ((ctx.body_ax + ctx.prev_body_ax) * momentum.x +
+                             (ctx.body_ay + ctx.prev_body_ay) * momentum.y);
+    ledger.damping_dissipated += 0.5 * ctx.dt * (el.damping_power + el.previous_damping_power);
+  }
+  ledger.update_max();
+
+  ctx.prev_body_ax = ctx.body_ax;
+  ctx.prev_body_ay = ctx.body_ay;
+  ctx.time += ctx.dt;
+  ++sim.step;
+}
+
+}  // namespace voussoir

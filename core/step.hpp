@@ -1,0 +1,69 @@
+#pragma once
+// One explicit step (STYLE.md "The step is one short function"): advance() calls the stages
+// in order, each stage reads the per-step context, no stage calls another, no I/O.
+//
+//   1. broad phase if some node moved more than the buffer allows
+//   2. clear forces
+//   3. element forces (finite-strain CST + Munjiza damping)      core/cst
+//   4. contact forces (potential penalty + Coulomb friction)       contact/
+//   5. body loads (gravity, lambda g, base motion)                 core/loads
+//   6. central-difference integration (v then x), kinetic energy   core/integrate
+
+#include <array>
+#include <vector>
+
+#include "contact/contact.hpp"
+#include "core/energy.hpp"
+#include "core/model.hpp"
+
+namespace voussoir {
+
+// Per-step context (Box2D b2StepContext): time step, body load, law constants.
+struct StepContext {
+  double dt = 0.0;           // [s]
+  double time = 0.0;         // [s], time at the start of the step
+  double body_ax = 0.0;      // body acceleration on free nodes [m/s2]: lambda g - a_g,x(t)
+  double body_ay = -9.81;    // -g - a_g,y(t)
+  double lame_lambda = 0.0;  // 2D law constants [Pa]
+  double shear_modulus = 0.0;
+  double eta = 0.0;  // Munjiza viscosity [Pa s]
+  bool contact_on = true;
+  // Body acceleration of the previous step, for the trapezoidal external work (core/loads.hpp);
+  // set by advance(), not by drivers.
+  double prev_body_ax = 0.0;
+  double prev_body_ay = 0.0;
+};
+
+// Wall-clock seconds spent per stage (accumulated).
+struct StageTimers {
+  double broad = 0.0, elements = 0.0, contact = 0.0, loads = 0.0, integrate = 0.0;
+  bool enabled = false;
+};
+
+struct Simulation {
+  Model model;
+  ContactSystem contact;
+  EnergyLedger ledger;
+  StepContext ctx;
+  StageTimers timers;
+  long long step = 0;
+  // Per-triangle V0 P_v of the last damped step (4 per triangle, row-major) for the exact
+  // damping work of the ledger (core/step.cpp); sized by advance(), empty when undamped.
+  std::vector<double> viscous_piola;
+};
+
+// Fills ctx law constants and eta from the model material and damping factor.
+void prepare_context(Simulation& sim, double damping_factor);
+
+// Stable time step [s] of the model (elements and, when on, contact), before the safety factor.
+double stable_time_step(const Simulation& sim);
+
+// Advances the simulation by ctx.dt. Energy ledger: strain and kinetic energy at the step
+// (core/integrate.hpp for the leapfrog K), external work and damping dissipation by the
+// trapezoid over the last position increment (exact for a linear system; core/step.cpp).
+// Contact energy and friction come from the contact stage. At the first step (sim.step == 0) the
+// energy of the initial state (K + U + contact) is booked as external work: whoever set the initial
+// state put it in, and balance_error() stays meaningful for runs from a disturbed state.
+void advance(Simulation& sim);
+
+}  // namespace voussoir

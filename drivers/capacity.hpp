@@ -1,0 +1,91 @@
+#pragma once
+// lambda* by bisection (SPEC.md section 2, `voussoir capacity`).
+//
+// A trial at load factor lambda:
+//   1. start from the settled state (gravity ramped on over `ramp_time`, then held until the
+//      structure is at rest by the stable criterion below; done once and shared by all trials);
+//   2. ramp the horizontal body load from 0 to lambda g over `ramp_time` (a ramp, not a step:
+//      a step load overshoots the static response by up to a factor of two in the contact
+//      springs and would open joints that the static load keeps closed; 0.1 s is about ten
+//      periods of the lowest mode of the shipped arches, so the ramp is quasi-static);
+//   3. classify with early termination:
+//      collapsed as soon as any free block's centroid has moved more than
+//        `collapse_displacement` x L_ref or rotated more than `collapse_rotation` since the
+//        settled state (L_ref: square root of the smallest free block area);
+//      stable as soon as, after the ramp, the largest free-node speed has stayed below
+//        `rest_speed` x sqrt(g L_ref) for `hold_time` without interruption;
+//      when neither happens by `max_time`, the trial is collapsed if the block motion is still
+//      growing (speed above the rest threshold), stable otherwise (reported as "timeout").
+// The thresholds are studied in docs/capacity.md.
+//
+// Bisection: the bracket [lo, hi] (stable at lo, collapsed at hi) shrinks by k-section with
+// `points` trial lambdas per round (run in parallel on the available cores); the number of
+// points is fixed, not taken from the thread count, so results do not depend on it. Stops when
+// hi - lo <= tolerance x hi; lambda* = (lo + hi) / 2.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/step.hpp"
+#include "drivers/kinematics.hpp"
+#include "io/config.hpp"
+
+namespace voussoir {
+
+struct TrialCriteria {
+  double ramp_time = 0.1;              // [s] load ramp (gravity when settling, lambda g after)
+  double collapse_displacement = 0.05; // x L_ref
+  double collapse_rotation = 0.05;     // [rad]
+  double rest_speed = 1e-4;            // x sqrt(g L_ref)
+  double hold_time = 0.05;             // [s]
+  double max_time = 3.0;               // [s] of simulated time after settling
+  double settle_max_time = 2.0;        // [s]
+};
+
+struct TrialResult {
+  double lambda = 0.0;
+  bool collapsed = false;
+  std::string reason;                  // "displacement", "rotation", "rest", "timeout"
+  double sim_time = 0.0;               // [s] simulated after settling
+  long long steps = 0;
+  double wall_s = 0.0;
+  double max_displacement = 0.0;       // largest block centroid displacement [m]
+  double max_rotation = 0.0;           // largest block rotation [rad]
+  double energy_balance_error = 0.0;
+  std::vector<Hinge> hinges;           // joints opened or slid at the end of the trial
+};
+
+struct SettledState {
+  Simulation sim;
+  double l_ref = 0.0;                  // [m]
+  double gravity = 9.81;
+  double settle_time = 0.0;            // [s]
+  long long steps = 0;
+  double wall_s = 0.0;
+  bool settled = false;
+};
+
+// Settles the model of `config` under gravity (lambda = 0).
+SettledState settle(const Config& config, const TrialCriteria& criteria, bool quiet);
+
+// One trial from a copy of the settled state.
+TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria);
+
+struct CapacityResult {
+  double lambda_star = 0.0;
+  double lo = 0.0, hi = 0.0;
+  double tolerance = 0.0;
+  std::vector<TrialResult> trials;     // in the order they were run
+  std::vector<Hinge> hinges;           // of the collapsed trial closest to lambda*
+  double wall_s = 0.0;
+  Index triangles = 0;
+  double dt = 0.0;                     // [s]
+  bool bracketed = false;              // false when no collapse was found up to the cap
+};
+
+// Bisection for lambda*; progress lines on stderr unless quiet.
+CapacityResult find_capacity(const Config& config, const TrialCriteria& criteria, int points,
+                             bool quiet);
+
+}  // namespace voussoir

@@ -1,0 +1,82 @@
+// `voussoir check DECK`: validate the deck, build the model, print its summary (SPEC.md
+// section 2) and optionally the meshed geometry as JSON for scripts/draw.
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "core/model.hpp"
+#include "drivers/commands.hpp"
+#include "drivers/setup.hpp"
+#include "io/json.hpp"
+#include "mesh/scene.hpp"
+
+namespace voussoir {
+
+nlohmann::json model_geometry_json(const Model& model) {
+  using nlohmann::json;
+  const Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  json nodes = json::array(), tris = json::array(), tri_block = json::array();
+  for (Index i = 0; i < n.size(); ++i) nodes.push_back({n.x[i], n.y[i]});
+  for (Index e = 0; e < t.size(); ++e) {
+    tris.push_back({t.n0[e], t.n1[e], t.n2[e]});
+    tri_block.push_back(t.block[e]);
+  }
+  json blocks = json::array();
+  for (const Block& b : model.blocks) {
+    json poly = json::array();
+    for (const Vec2& p : b.polygon) poly.push_back({p.x, p.y});
+    blocks.push_back({{"fixed", b.fixed}, {"role", b.role}, {"polygon", poly}});
+  }
+  json joints = json::array();
+  for (const Joint& j : model.joints)
+    joints.push_back({{"blocks", {j.block_a, j.block_b}},
+                      {"a", {j.a.x, j.a.y}},
+                      {"b", {j.b.x, j.b.y}},
+                      {"position_deg", j.position_deg}});
+  return {{"kind", model.kind}, {"nodes", nodes},   {"triangles", tris},
+          {"tri_block", tri_block}, {"blocks", blocks}, {"joints", joints}};
+}
+
+int command_check(const Config& config, const CommonOptions& common, const CheckOptions& opts) {
+  SetupInfo info;
+  Simulation sim = make_simulation(config, &info);
+  const Model& m = sim.model;
+  int free_blocks = 0;
+  for (const Block& b : m.blocks) free_blocks += b.fixed ? 0 : 1;
+  const double worst = worst_triangle_angle_deg(m);
+
+  std::printf("deck        %s\n", config.deck_path.c_str());
+  std::printf("model       %s\n", m.kind.c_str());
+  std::printf("blocks      %zu (%d free, %zu fixed)\n", m.blocks.size(), free_blocks,
+              m.blocks.size() - free_blocks);
+  std::printf("triangles   %d\n", m.tris.size());
+  std::printf("nodes       %d\n", m.nodes.size());
+  std::printf("free area   %.6g m2\n", free_area(m));
+  std::printf("mass        %.6g kg (free blocks, out-of-plane %.4g m)\n", free_mass(m),
+              m.out_of_plane);
+  std::printf("worst angle %.2f deg\n", worst);
+  std::printf("dt          %.4g s (stable limit %.4g s)\n", info.dt, info.dt_stable);
+  std::printf("penalty     %.4g Pa\n", info.penalty);
+  std::printf("damping eta %.4g Pa s\n", info.eta);
+
+  if (!common.json_path.empty()) {
+    nlohmann::json j = {{"blocks", m.blocks.size()},
+                        {"free_blocks", free_blocks},
+                        {"triangles", m.tris.size()},
+                        {"nodes", m.nodes.size()},
+                        {"free_area", free_area(m)},
+                        {"mass", free_mass(m)},
+                        {"dt", info.dt},
+                        {"dt_stable", info.dt_stable},
+                        {"penalty", info.penalty},
+                        {"eta", info.eta},
+                        {"worst_angle_deg", worst},
+                        {"joints", m.joints.size()}};
+    write_json(j, common.json_path);
+  }
+  if (!opts.mesh_out.empty()) write_json(model_geometry_json(m), opts.mesh_out);
+  return 0;
+}
+
+}  // namespace voussoir

@@ -1,0 +1,68 @@
+// `voussoir capacity DECK`: lambda* by k-section bisection, with every trial in the JSON.
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "drivers/capacity.hpp"
+#include "drivers/commands.hpp"
+#include "io/json.hpp"
+
+namespace voussoir {
+
+nlohmann::json hinges_json(const std::vector<Hinge>& hinges) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Hinge& h : hinges)
+    out.push_back({{"joint", h.joint},
+                   {"blocks", {h.block_a, h.block_b}},
+                   {"kind", h.kind},
+                   {"side", h.side},
+                   {"position_deg", h.position_deg},
+                   {"x", h.x},
+                   {"y", h.y},
+                   {"opening", h.opening},
+                   {"slip", h.slip}});
+  return out;
+}
+
+int command_capacity(const Config& config, const CommonOptions& common,
+                     const CapacityOptions& opts) {
+  const TrialCriteria criteria;
+  const CapacityResult res = find_capacity(config, criteria, opts.points, common.quiet);
+
+  std::printf("lambda* = %.4f  bracket [%.4f, %.4f]  %zu trials  %.1f s wall\n", res.lambda_star,
+              res.lo, res.hi, res.trials.size(), res.wall_s);
+  if (!res.bracketed)
+    std::printf("no collapse found up to lambda = 8: lambda* is at least %.4f\n", res.lo);
+  for (const Hinge& h : res.hinges)
+    std::printf("  %-7s joint %d (blocks %d-%d) at %.1f deg%s%s\n", h.kind.c_str(), h.joint,
+                h.block_a, h.block_b, h.position_deg, h.side.empty() ? "" : ", pivot at ",
+                h.side.c_str());
+
+  if (!common.json_path.empty()) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const TrialResult& r : res.trials)
+      runs.push_back({{"lambda", r.lambda},
+                      {"collapsed", r.collapsed},
+                      {"reason", r.reason},
+                      {"sim_time", r.sim_time},
+                      {"steps", r.steps},
+                      {"wall_s", r.wall_s},
+                      {"max_displacement", r.max_displacement},
+                      {"max_rotation", r.max_rotation},
+                      {"energy_balance_error", r.energy_balance_error}});
+    nlohmann::json j = {{"lambda_star", res.lambda_star},
+                        {"bracket", {res.lo, res.hi}},
+                        {"bracketed", res.bracketed},
+                        {"tolerance", res.tolerance},
+                        {"runs", runs},
+                        {"triangles", res.triangles},
+                        {"dt", res.dt},
+                        {"wall_s", res.wall_s},
+                        {"points_per_round", opts.points},
+                        {"hinges", hinges_json(res.hinges)}};
+    write_json(j, common.json_path);
+  }
+  return 0;
+}
+
+}  // namespace voussoir

@@ -1,0 +1,57 @@
+#pragma once
+// The subcommands of the voussoir program (SPEC.md section 2). Each takes the validated deck
+// and its options, prints a human summary on stdout, progress on stderr, and writes the JSON
+// summary when asked. Errors: DeckError (exit 2), RunError (exit 1).
+
+#include <string>
+#include <vector>
+
+#include "io/config.hpp"
+
+namespace voussoir {
+
+struct CommonOptions {
+  std::string json_path;     // --json FILE ("" = none, "-" = stdout)
+  int threads = 0;           // --threads N (0 = OpenMP default)
+  bool quiet = false;        // no progress on stderr
+};
+
+struct CheckOptions {
+  std::string mesh_out;      // --mesh-out FILE: model geometry as JSON (for scripts/draw)
+};
+
+int command_check(const Config& config, const CommonOptions& common, const CheckOptions& opts);
+
+struct RunOptions {
+  std::string output;        // -o FILE: HDF5 output (overrides output.file)
+};
+
+int command_run(const Config& config, const CommonOptions& common, const RunOptions& opts);
+
+}  // namespace voussoir
+
+namespace voussoir {
+
+struct CapacityOptions {
+  int points = 2;            // trial lambdas per bisection round (k-section with k = points+1)
+};
+
+int command_capacity(const Config& config, const CommonOptions& common,
+                     const CapacityOptions& opts);
+
+}  // namespace voussoir
+
+namespace voussoir {
+
+struct SweepOptions {
+  std::vector<std::string> params;   // --param KEY=V1,V2,... (several make a grid)
+  std::string csv;                   // --csv FILE (default: sweep.csv)
+  std::string plot;                  // --plot FILE.png (drawn by scripts/plot_sweep)
+  int points = 2;
+};
+
+// Runs capacity over the grid; `deck_path` and `sets` rebuild the deck per cell.
+int command_sweep(const std::string& deck_path, const std::vector<std::string>& sets,
+                  const CommonOptions& common, const SweepOptions& opts);
+
+}  // namespace voussoir

@@ -1,0 +1,57 @@
+#include "drivers/setup.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "io/deck.hpp"
+#include "mesh/scene.hpp"
+
+namespace voussoir {
+
+double contact_penalty(const Config& config) {
+  if (config.contact.penalty > 0.0) return config.contact.penalty;
+  Material m;
+  m.young = config.material.young;
+  m.poisson = config.material.poisson;
+  return config.contact.penalty_factor * m.lame_lambda();
+}
+
+void set_static_load(Simulation& sim, double gravity, double lambda) {
+  sim.ctx.body_ax = lambda * gravity;
+  sim.ctx.body_ay = -gravity;
+}
+
+Simulation make_simulation(const Config& config, SetupInfo* info) {
+  Simulation sim;
+  sim.model = build_model(config);
+  ContactParams cp;
+  cp.penalty = contact_penalty(config);
+  cp.friction = config.contact.friction;
+  cp.buffer = config.contact.buffer;
+  sim.contact.setup(sim.model, cp);
+  prepare_context(sim, config.solver.damping_factor);
+  set_static_load(sim, config.load.gravity, config.load.lambda);
+
+  const double dt_stable = stable_time_step(sim);
+  double dt = config.solver.dt_safety * dt_stable;
+  if (config.solver.dt > 0.0) {
+    if (config.solver.dt > dt_stable) {
+      std::ostringstream msg;
+      msg << config.deck_path << ": solver.dt = " << config.solver.dt
+          << " s is above the stable limit " << dt_stable
+          << " s of this model (use dt = \"auto\" or a value below the limit)";
+      throw DeckError(msg.str());
+    }
+    dt = config.solver.dt;
+  }
+  sim.ctx.dt = dt;
+  if (info) {
+    info->dt = dt;
+    info->dt_stable = dt_stable;
+    info->penalty = cp.penalty;
+    info->eta = sim.ctx.eta;
+  }
+  return sim;
+}
+
+}  // namespace voussoir

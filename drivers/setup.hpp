@@ -1,0 +1,35 @@
+#pragma once
+// From a validated deck to a ready Simulation: build and mesh the scene, set the contact
+// penalty, damping and time step. Shared by every subcommand, test and benchmark.
+
+#include <stdexcept>
+#include <string>
+
+#include "core/step.hpp"
+#include "io/config.hpp"
+
+namespace voussoir {
+
+// A failure during a run (non-finite state, energy blow-up): exit status 1.
+struct RunError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct SetupInfo {
+  double dt = 0.0;           // time step in use [s]
+  double dt_stable = 0.0;    // stable limit before the safety factor [s]
+  double penalty = 0.0;      // contact penalty Ep [Pa]
+  double eta = 0.0;          // damping viscosity [Pa s]
+};
+
+// Contact penalty of the deck: contact.penalty if given, else penalty_factor x Lamé's first
+// constant of the material.
+double contact_penalty(const Config& config);
+
+// Builds the simulation. A user dt above the stable limit throws DeckError naming the limit.
+Simulation make_simulation(const Config& config, SetupInfo* info = nullptr);
+
+// Sets the body load of the context: gravity down, lambda g horizontal.
+void set_static_load(Simulation& sim, double gravity, double lambda);
+
+}  // namespace voussoir

@@ -1,0 +1,109 @@
+#pragma once
+// The validated contents of a deck (SPEC.md "Deck keys"). io/deck.cpp fills it from TOML and
+// `--set` overrides; everything downstream reads only this struct, never the TOML.
+// Defaults below are the defaults of a deck that omits the key.
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace voussoir {
+
+struct ModelConfig {
+  std::string kind;                    // required: circular_arch, basket_arch, buttressed_arch,
+                                       // church, block, polygons
+  double radius = 1.0;                 // centreline radius Rc [m]
+  double thickness = 0.2;              // arch thickness t [m]
+  double embrace = 180.0;              // beta [deg]
+  int voussoirs = 11;
+  double offset = 0.5;                 // basket d [m]
+  double small_radius = 0.5;           // basket r [m]
+  std::string shape = "circular";      // buttressed_arch: "circular" or "basket"
+  double buttress_width = 0.8;         // B [m]
+  double base_depth = 3.0;             // H1 [m]
+  double courses = 0.0;                // 0 = monolithic, else course height [m]
+  std::vector<double> spans = {4.0, 6.0, 4.0};  // church clear spans [m]
+  double height = 5.0;                 // church support height; block height [m]
+  double pier_width = 1.0;             // [m]
+  double outer_width = 1.2;            // [m]
+  double eccentricity = 0.25;          // -
+  double voussoir_angle = 2.0;         // [deg]
+  double width = 0.5;                  // block width [m]
+  double incline = 0.0;                // block ground incline [deg]
+  int stack = 1;                       // number of stacked blocks
+  std::string file;                    // polygons: path (resolved against the deck folder)
+  std::vector<int> fixed;              // polygons: indices of fixed blocks
+  double out_of_plane = 1.0;           // [m]
+  // Which keys the deck actually gave (so generators can tell a default from a choice).
+  std::vector<std::string> given;
+  bool has(const std::string& key) const;
+};
+
+struct MeshConfig {
+  double size = 0.0;                   // target element size [m]; 0 = use through_thickness
+  int through_thickness = 1;           // elements across the thickness (arches)
+};
+
+struct MaterialConfig {
+  double density = 2000.0;             // kg/m3
+  double young = 40e9;                 // Pa
+  double poisson = 0.2;
+  std::string plane = "strain";        // "strain" or "stress"
+};
+
+struct ContactConfig {
+  double friction = 0.6;               // Coulomb mu
+  double penalty_factor = 100.0;       // Ep = factor x Lamé's first constant
+  double penalty = 0.0;                // Ep [Pa]; 0 = use penalty_factor
+  double buffer = 0.0;                 // NBS buffer [m]; 0 = automatic
+};
+
+struct SolverConfig {
+  double dt = 0.0;                     // [s]; 0 = "auto"
+  double dt_safety = 0.5;              // fraction of the stable limit used by "auto"
+  double damping_factor = 1.0;         // scales eta = 2 h sqrt(E rho)
+  double end_time = 1.0;               // [s]
+};
+
+struct BaseConfig {
+  std::string signal = "none";         // none, windowed_sine, sine_pulse, file
+  double amplitude = 0.0;              // [g]
+  double frequency = 1.0;              // [Hz]
+  int cycles = 3;
+  std::string file;                    // accelerogram (time, acceleration)
+  std::string units = "g";             // of the file's acceleration column: "g" or "m/s2"
+  std::array<double, 2> band = {0.0, 0.0};  // band-pass [Hz]; {0,0} = no filter
+};
+
+struct LoadConfig {
+  double gravity = 9.81;               // [m/s2]
+  double lambda = 0.0;                 // horizontal body load factor (x gravity)
+  BaseConfig base;
+};
+
+struct CapacityConfig {
+  double lambda_min = 0.0;             // bracket; both 0 = automatic
+  double lambda_max = 0.0;
+  double tolerance = 0.005;            // relative bracket width
+};
+
+struct OutputConfig {
+  std::string file;                    // HDF5 path; empty = no HDF5 output
+  double every = 0.01;                 // snapshot interval [s]
+  std::vector<std::string> fields = {"position", "velocity", "stress"};
+};
+
+struct Config {
+  std::string deck_path;               // as given on the command line
+  std::string deck_dir;                // folder of the deck, for relative paths
+  ModelConfig model;
+  MeshConfig mesh;
+  MaterialConfig material;
+  ContactConfig contact;
+  SolverConfig solver;
+  LoadConfig load;
+  CapacityConfig capacity;
+  OutputConfig output;
+};
+
+}  // namespace voussoir

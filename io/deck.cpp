@@ -1,0 +1,651 @@
+// Deck reading and validation (SPEC.md "Deck keys").
+//
+// How a deck becomes a Config:
+//   1. the text is parsed by toml++ (a syntax error becomes "FILE:LINE:COL: TOML syntax error");
+//   2. each `--set KEY=VALUE` is parsed as a TOML value (a bare word that is not valid TOML is
+//      taken as a string) and inserted at its dotted path, replacing what the file said, so the
+//      overrides go through exactly the same validation as the file;
+//   3. the table is walked: every key must be one of the `kKeys` below (an unknown one is
+//      reported with the nearest known key by edit distance); each key's reader checks the
+//      type and the range and stores the value;
+//   4. cross-key checks run last (required keys, lambda_min < lambda_max, input files exist).
+// The first problem found throws DeckError with one line: where (file:line:column, or
+// "--set"), the dotted key, the value as written and what is allowed.
+//
+// Decisions:
+//   - integers are accepted where a number is expected; a float (even 3.0) is refused where an
+//     integer is required, because a fractional count is almost always a typing slip;
+//   - nan and inf are refused everywhere;
+//   - relative `model.file` and `load.base.file` from the deck file are resolved against the
+//     deck's folder; the same keys given with `--set` are typed on the command line and are
+//     taken relative to the current directory, as a shell user expects;
+//   - keys that the chosen model kind does not use are accepted (a deck can be switched between
+//     kinds with `--set model.kind=...`), and recorded in ModelConfig::given all the same.
+
+#include "io/deck.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace voussoir {
+
+bool ModelConfig::has(const std::string& key) const {
+  // Accepts "embrace" as well as "model.embrace".
+  const std::string leaf = key.rfind("model.", 0) == 0 ? key.substr(6) : key;
+  return std::find(given.begin(), given.end(), leaf) != given.end();
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// An allowed interval for a number; open or closed at each end; +-inf = unbounded.
+struct Range {
+  double lo = -kInf;
+  bool lo_open = false;
+  double hi = kInf;
+  bool hi_open = false;
+};
+Range above(double lo) {
+  return {lo, true, kInf, false};
+}  // (lo, inf)
+Range at_least(double lo) {
+  return {lo, false, kInf, false};
+}  // [lo, inf)
+Range any_finite() {
+  return {};
+}
+
+std::string format_number(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+std::string describe(const Range& r, const char* what) {
+  std::string s = what;
+  const bool has_lo = std::isfinite(r.lo), has_hi = std::isfinite(r.hi);
+  if (has_lo && has_hi) {
+    s += std::string(" in ") + (r.lo_open ? "(" : "[") + format_number(r.lo) + ", " +
+         format_number(r.hi) + (r.hi_open ? ")" : "]");
+  } else if (has_lo) {
+    s += std::string(r.lo_open ? " > " : " >= ") + format_number(r.lo);
+  } else if (has_hi) {
+    s += std::string(r.hi_open ? " < " : " <= ") + format_number(r.hi);
+  }
+  return s;
+}
+
+bool inside(const Range& r, double v) {
+  if (!std::isfinite(v)) return false;
+  if (r.lo_open ? !(v > r.lo) : !(v >= r.lo)) return false;
+  if (r.hi_open ? !(v < r.hi) : !(v <= r.hi)) return false;
+  return true;
+}
+
+// The value as the user wrote it, on one line.
+std::string value_text(const toml::node& n) {
+  if (const auto* s = n.as_string()) return "\"" + s->get() + "\"";
+  if (const auto* i = n.as_integer()) return std::to_string(i->get());
+  if (const auto* f = n.as_floating_point()) {
+    // Show 11.0 as "11.0", so "expected an integer" makes sense next to it.
+    std::string s = format_number(f->get());
+    if (s.find_first_of(".eEni") == std::string::npos) s += ".0";
+    return s;
+  }
+  if (const auto* b = n.as_boolean()) return b->get() ? "true" : "false";
+  if (const auto* a = n.as_array()) {
+    std::string s = "[";
+    for (std::size_t k = 0; k < a->size(); ++k) {
+      if (k) s += ", ";
+      s += value_text(*a->get(k));
+    }
+    return s + "]";
+  }
+  if (n.is_table()) return "{...} (a table)";
+  return "(a date/time)";
+}
+
+std::string one_line(std::string s) {
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  std::replace(s.begin(), s.end(), '\r', ' ');
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+std::string join(const std::vector<std::string>& items, const char* sep = ", ") {
+  std::string s;
+  for (std::size_t k = 0; k < items.size(); ++k) s += (k ? sep : "") + items[k];
+  return s;
+}
+
+// Optimal-string-alignment edit distance (Levenshtein plus adjacent transpositions, so the
+// common slip "frictoin" is one edit from "friction").
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  const std::size_t n = a.size(), m = b.size();
+  std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1));
+  for (std::size_t i = 0; i <= n; ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= m; ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= n; ++i) {
+    for (std::size_t j = 1; j <= m; ++j) {
+      const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  }
+  return d[n][m];
+}
+
+// ---------------------------------------------------------------------------------------------
+// The reader: knows where the current value came from and turns every refusal into one line.
+
+struct Reader {
+  std::string source;                             // deck file name (or the text's label)
+  std::string deck_dir;                           // for relative input files
+  std::map<std::string, std::string> set_raw;     // dotted key -> raw VALUE of its --set
+  std::map<std::string, const toml::node*> seen;  // dotted key -> node, for every key given
+  std::string key;                                // dotted key being read
+
+  bool from_set(const std::string& k) const { return set_raw.count(k) != 0; }
+
+  // "deck.toml:7:11: " or "deck.toml: --set ".
+  std::string where(const std::string& k, const toml::node* n) const {
+    if (from_set(k)) return source + ": --set ";
+    if (n != nullptr) {
+      const auto& b = n->source().begin;
+      if (b.line > 0)
+        return source + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": ";
+    }
+    return source + ": ";
+  }
+
+  [[noreturn]] void fail(const toml::node& n, const std::string& allowed) const {
+    throw DeckError(
+        one_line(where(key, &n) + key + " = " + value_text(n) + ": expected " + allowed));
+  }
+
+  double number(const toml::node& n, const Range& r, const char* unit = nullptr) const {
+    const std::string u = unit ? std::string(" [") + unit + "]" : std::string();
+    const std::string allowed = describe(r, "a number") + u;
+    double v = 0.0;
+    if (const auto* i = n.as_integer()) {
+      v = static_cast<double>(i->get());
+    } else if (const auto* f = n.as_floating_point()) {
+      v = f->get();
+      if (!std::isfinite(v)) fail(n, describe(r, "a finite number") + u);
+    } else {
+      fail(n, allowed);
+    }
+    if (!inside(r, v)) fail(n, allowed);
+    return v;
+  }
+
+  int integer(const toml::node& n, std::int64_t lo, std::int64_t hi) const {
+    const std::string allowed =
+        "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    const auto* i = n.as_integer();
+    if (i == nullptr) fail(n, allowed);
+    if (i->get() < lo || i->get() > hi) fail(n, allowed);
+    return static_cast<int>(i->get());
+  }
+
+  std::string string(const toml::node& n) const {
+    if (const auto* s = n.as_string()) return s->get();
+    // `--set output.file=2024` parses as an integer; for a string key take the text typed.
+    if (auto it = set_raw.find(key); it != set_raw.end() && !n.is_array() && !n.is_table())
+      return it->second;
+    fail(n, "a string");
+  }
+
+  std::string choice(const toml::node& n, const std::vector<std::string>& allowed) const {
+    const std::string what = "one of \"" + join(allowed, "\", \"") + "\"";
+    if (!n.is_string() && !from_set(key)) fail(n, what);
+    const std::string s = n.is_string() ? n.as_string()->get() : set_raw.at(key);
+    if (std::find(allowed.begin(), allowed.end(), s) == allowed.end()) fail(n, what);
+    return s;
+  }
+
+  const toml::array& array(const toml::node& n, const std::string& what) const {
+    const auto* a = n.as_array();
+    if (a == nullptr) fail(n, what);
+    return *a;
+  }
+
+  // A file the run will read: resolved against the deck folder (file keys) or the current
+  // directory (--set), and it must be readable.
+  std::string input_file(const toml::node& n) const {
+    const std::string s = string(n);
+    if (s.empty()) fail(n, "a file name");
+    fs::path p(s);
+    if (p.is_relative() && !from_set(key)) p = (fs::path(deck_dir) / p).lexically_normal();
+    return p.string();
+  }
+};
+
+using Apply = void (*)(Reader&, const toml::node&, Config&);
+struct KeySpec {
+  const char* key;
+  Apply apply;
+};
+
+const std::vector<std::string> kKinds = {"circular_arch", "basket_arch", "buttressed_arch",
+                                         "church",        "block",       "polygons"};
+
+// Every key of the deck with its reader. Ranges are engineering limits: a value outside them
+// is a typing slip or a unit error (kPa for Pa, radians for degrees), never a real structure.
+const std::vector<KeySpec>& key_table() {
+  static const std::vector<KeySpec> table = {
+      // [model]
+      {"model.kind", [](Reader& r, const toml::node& n, Config& c) { c.model.kind = r.choice(n, kKinds); }},
+      {"model.radius", [](Reader& r, const toml::node& n, Config& c) { c.model.radius = r.number(n, above(0), "m"); }},
+      {"model.thickness", [](Reader& r, const toml::node& n, Config& c) { c.model.thickness = r.number(n, above(0), "m"); }},
+      {"model.embrace", [](Reader& r, const toml::node& n, Config& c) { c.model.embrace = r.number(n, {0, true, 360, true}, "deg"); }},
+      {"model.voussoirs", [](Reader& r, const toml::node& n, Config& c) { c.model.voussoirs = r.integer(n, 1, 100000); }},
+      {"model.offset", [](Reader& r, const toml::node& n, Config& c) { c.model.offset = r.number(n, at_least(0), "m"); }},
+      {"model.small_radius", [](Reader& r, const toml::node& n, Config& c) { c.model.small_radius = r.number(n, above(0), "m"); }},
+      {"model.shape", [](Reader& r, const toml::node& n, Config& c) { c.model.shape = r.choice(n, {"circular", "basket"}); }},
+      {"model.buttress_width", [](Reader& r, const toml::node& n, Config& c) { c.model.buttress_width = r.number(n, above(0), "m"); }},
+      {"model.base_depth", [](Reader& r, const toml::node& n, Config& c) { c.model.base_depth = r.number(n, above(0), "m"); }},
+      {"model.courses", [](Reader& r, const toml::node& n, Config& c) { c.model.courses = r.number(n, at_least(0), "m, 0 = monolithic"); }},
+      {"model.spans", [](Reader& r, const toml::node& n, Config& c) {
+         const char* what = "a non-empty array of spans > 0 [m]";
+         const toml::array& a = r.array(n, what);
+         if (a.empty()) r.fail(n, what);
+         c.model.spans.clear();
+         for (const toml::node& e : a) {
+           const double v = e.is_number() ? e.value<double>().value_or(0.0) : 0.0;
+           if (!e.is_number() || !inside(above(0), v)) r.fail(n, what);
+           c.model.spans.push_back(v);
+         }
+       }},
+      {"model.height", [](Reader& r, const toml::node& n, Config& c) { c.model.height = r.number(n, above(0), "m"); }},
+      {"model.pier_width", [](Reader& r, const toml::node& n, Config& c) { c.model.pier_width = r.number(n, above(0), "m"); }},
+      {"model.outer_width", [](Reader& r, const toml::node& n, Config& c) { c.model.outer_width = r.number(n, above(0), "m"); }},
+      {"model.eccentricity", [](Reader& r, const toml::node& n, Config& c) { c.model.eccentricity = r.number(n, {0, false, 2, false}); }},
+      {"model.voussoir_angle", [](Reader& r, const toml::node& n, Config& c) { c.model.voussoir_angle = r.number(n, {0, true, 90, true}, "deg"); }},
+      {"model.width", [](Reader& r, const toml::node& n, Config& c) { c.model.width = r.number(n, above(0), "m"); }},
+      {"model.incline", [](Reader& r, const toml::node& n, Config& c) { c.model.incline = r.number(n, {0, false, 90, true}, "deg"); }},
+      {"model.stack", [](Reader& r, const toml::node& n, Config& c) { c.model.stack = r.integer(n, 1, 1000); }},
+      {"model.file", [](Reader& r, const toml::node& n, Config& c) { c.model.file = r.input_file(n); }},
+      {"model.fixed", [](Reader& r, const toml::node& n, Config& c) {
+         const char* what = "an array of distinct block indices (integers >= 0)";
+         const toml::array& a = r.array(n, what);
+         c.model.fixed.clear();
+         for (const toml::node& e : a) {
+           const auto* i = e.as_integer();
+           if (i == nullptr || i->get() < 0 || i->get() > std::numeric_limits<int>::max())
+             r.fail(n, what);
+           const int v = static_cast<int>(i->get());
+           if (std::find(c.model.fixed.begin(), c.model.fixed.end(), v) != c.model.fixed.end())
+             r.fail(n, what);
+           c.model.fixed.push_back(v);
+         }
+       }},
+      {"model.out_of_plane", [](Reader& r, const toml::node& n, Config& c) { c.model.out_of_plane = r.number(n, above(0), "m"); }},
+      // [mesh]
+      {"mesh.size", [](Reader& r, const toml::node& n, Config& c) { c.mesh.size = r.number(n, at_least(0), "m, 0 = use mesh.through_thickness"); }},
+      {"mesh.through_thickness", [](Reader& r, const toml::node& n, Config& c) { c.mesh.through_thickness = r.integer(n, 1, 1000); }},
+      // [material]
+      {"material.density", [](Reader& r, const toml::node& n, Config& c) { c.material.density = r.number(n, above(0), "kg/m3"); }},
+      {"material.young", [](Reader& r, const toml::node& n, Config& c) { c.material.young = r.number(n, above(0), "Pa"); }},
+      {"material.poisson", [](Reader& r, const toml::node& n, Config& c) { c.material.poisson = r.number(n, {0, false, 0.5, true}); }},
+      {"material.plane", [](Reader& r, const toml::node& n, Config& c) { c.material.plane = r.choice(n, {"strain", "stress"}); }},
+      // [contact]
+      {"contact.friction", [](Reader& r, const toml::node& n, Config& c) { c.contact.friction = r.number(n, at_least(0)); }},
+      {"contact.penalty_factor", [](Reader& r, const toml::node& n, Config& c) { c.contact.penalty_factor = r.number(n, above(0), "x Lame's first constant"); }},
+      {"contact.penalty", [](Reader& r, const toml::node& n, Config& c) { c.contact.penalty = r.number(n, at_least(0), "Pa, 0 = use contact.penalty_factor"); }},
+      {"contact.buffer", [](Reader& r, const toml::node& n, Config& c) { c.contact.buffer = r.number(n, at_least(0), "m, 0 = automatic"); }},
+      // [solver]
+      {"solver.dt", [](Reader& r, const toml::node& n, Config& c) {
+         const char* what = "\"auto\" or a time step > 0 [s]";
+         if (n.is_string() || (r.from_set(r.key) && !n.is_number())) {
+           if (r.string(n) != "auto") r.fail(n, what);
+           c.solver.dt = 0.0;
+           return;
+         }
+         if (!n.is_number()) r.fail(n, what);
+         const double v = n.value<double>().value_or(0.0);
+         if (!inside(above(0), v)) r.fail(n, what);
+         c.solver.dt = v;
+       }},
+      {"solver.dt_safety", [](Reader& r, const toml::node& n, Config& c) { c.solver.dt_safety = r.number(n, {0, true, 1, false}); }},
+      {"solver.damping_factor", [](Reader& r, const toml::node& n, Config& c) { c.solver.damping_factor = r.number(n, at_least(0)); }},
+      {"solver.end_time", [](Reader& r, const toml::node& n, Config& c) { c.solver.end_time = r.number(n, above(0), "s"); }},
+      // [load]
+      {"load.gravity", [](Reader& r, const toml::node& n, Config& c) { c.load.gravity = r.number(n, at_least(0), "m/s2"); }},
+      {"load.lambda", [](Reader& r, const toml::node& n, Config& c) { c.load.lambda = r.number(n, any_finite(), "x gravity"); }},
+      // [load.base]
+      {"load.base.signal", [](Reader& r, const toml::node& n, Config& c) { c.load.base.signal = r.choice(n, {"none", "windowed_sine", "sine_pulse", "file"}); }},
+      {"load.base.amplitude", [](Reader& r, const toml::node& n, Config& c) { c.load.base.amplitude = r.number(n, any_finite(), "g"); }},
+      {"load.base.frequency", [](Reader& r, const toml::node& n, Config& c) { c.load.base.frequency = r.number(n, above(0), "Hz"); }},
+      {"load.base.cycles", [](Reader& r, const toml::node& n, Config& c) { c.load.base.cycles = r.integer(n, 1, 1000); }},
+      {"load.base.file", [](Reader& r, const toml::node& n, Config& c) { c.load.base.file = r.input_file(n); }},
+      {"load.base.units", [](Reader& r, const toml::node& n, Config& c) { c.load.base.units = r.choice(n, {"g", "m/s2"}); }},
+      {"load.base.band", [](Reader& r, const toml::node& n, Config& c) {
+         const char* what = "[low, high] in Hz with 0 <= low < high, or [0, 0] for no filter";
+         const toml::array& a = r.array(n, what);
+         if (a.size() != 2 || !a[0].is_number() || !a[1].is_number()) r.fail(n, what);
+         const double lo = a[0].value<double>().value_or(0.0), hi = a[1].value<double>().value_or(0.0);
+         if (!std::isfinite(lo) || !std::isfinite(hi)) r.fail(n, what);
+         if (!(lo == 0.0 && hi == 0.0) && !(lo >= 0.0 && lo < hi)) r.fail(n, what);
+         c.load.base.band = {lo, hi};
+       }},
+      // [capacity]
+      {"capacity.lambda_min", [](Reader& r, const toml::node& n, Config& c) { c.capacity.lambda_min = r.number(n, at_least(0)); }},
+      {"capacity.lambda_max", [](Reader& r, const toml::node& n, Config& c) { c.capacity.lambda_max = r.number(n, at_least(0)); }},
+      {"capacity.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.capacity.tolerance = r.number(n, {0, true, 1, true}, "relative bracket width"); }},
+      // [output]
+      {"output.file", [](Reader& r, const toml::node& n, Config& c) { c.output.file = r.string(n); }},
+      {"output.every", [](Reader& r, const toml::node& n, Config& c) { c.output.every = r.number(n, above(0), "s"); }},
+      {"output.fields", [](Reader& r, const toml::node& n, Config& c) {
+         const char* what = "an array of distinct names among \"position\", \"velocity\", \"stress\"";
+         static const std::vector<std::string> allowed = {"position", "velocity", "stress"};
+         const toml::array& a = r.array(n, what);
+         c.output.fields.clear();
+         for (const toml::node& e : a) {
+           const auto* s = e.as_string();
+           if (s == nullptr || std::find(allowed.begin(), allowed.end(), s->get()) == allowed.end())
+             r.fail(n, what);
+           if (std::find(c.output.fields.begin(), c.output.fields.end(), s->get()) != c.output.fields.end())
+             r.fail(n, what);
+           c.output.fields.push_back(s->get());
+         }
+       }},
+  };
+  return table;
+}
+
+const KeySpec* find_key(const std::string& dotted) {
+  for (const KeySpec& k : key_table())
+    if (dotted == k.key) return &k;
+  return nullptr;
+}
+
+// Sections are the prefixes of the known keys: model, mesh, ..., load, load.base, ...
+const std::set<std::string>& sections() {
+  static const std::set<std::string> s = [] {
+    std::set<std::string> out;
+    for (const KeySpec& k : key_table()) {
+      const std::string key = k.key;
+      for (std::size_t p = key.find('.'); p != std::string::npos; p = key.find('.', p + 1))
+        out.insert(key.substr(0, p));
+    }
+    return out;
+  }();
+  return s;
+}
+
+std::string leaf_of(const std::string& dotted) {
+  const std::size_t p = dotted.rfind('.');
+  return p == std::string::npos ? dotted : dotted.substr(p + 1);
+}
+
+std::string section_of(const std::string& dotted) {
+  const std::size_t p = dotted.rfind('.');
+  return p == std::string::npos ? std::string() : dotted.substr(0, p);
+}
+
+// The known key (or section) nearest to an unknown one, or "" when nothing is close.
+// Score of a candidate: the edit distance of the whole dotted path, or, for a key of another
+// section, the distance of the key names plus one (so "model.frction" finds
+// "contact.friction"). Close enough to be a slip: at most one edit per four characters of the
+// name, and two edits are always allowed.
+std::string suggest(const std::string& unknown) {
+  const std::string leaf = leaf_of(unknown), section = section_of(unknown);
+  std::string best;
+  std::size_t best_score = std::numeric_limits<std::size_t>::max();
+  auto consider = [&](const std::string& cand, bool is_key) {
+    std::size_t score = edit_distance(unknown, cand);
+    if (is_key && section_of(cand) != section)
+      score = std::min(score, edit_distance(leaf, leaf_of(cand)) + 1);
+    if (score < best_score) best_score = score, best = cand;
+  };
+  for (const KeySpec& k : key_table()) consider(k.key, true);
+  for (const std::string& s : sections()) consider(s, false);
+  const std::size_t limit = std::max<std::size_t>(2, leaf.size() / 4);
+  return best_score <= limit ? best : std::string();
+}
+
+[[noreturn]] void fail_unknown(const Reader& r, const std::string& dotted, const toml::node& n,
+                               bool is_section) {
+  std::string msg;
+  const std::string what =
+      is_section ? "unknown section [" + dotted + "]" : "unknown key '" + dotted + "'";
+  // The --set that brought it: the key itself, or a key below an unknown section.
+  auto origin = r.set_raw.find(dotted);
+  if (origin == r.set_raw.end()) {
+    origin = r.set_raw.lower_bound(dotted + ".");
+    if (origin != r.set_raw.end() && origin->first.rfind(dotted + ".", 0) != 0)
+      origin = r.set_raw.end();
+  }
+  if (origin != r.set_raw.end()) {
+    msg = r.source + ": " + what + " in --set " + origin->first + "=" + origin->second;
+  } else {
+    msg = r.where(dotted, &n) + what;
+  }
+  const std::string s = suggest(dotted);
+  if (!s.empty()) msg += " (did you mean '" + s + "'?)";
+  throw DeckError(one_line(msg));
+}
+
+// A --set inside a table that came only from --set: the keys below it carry its origin.
+void mark_set_subtree(Reader& r, const std::string& prefix, const toml::node& n,
+                      const std::string& raw) {
+  if (const auto* t = n.as_table()) {
+    for (auto&& [k, v] : *t) mark_set_subtree(r, prefix + "." + std::string(k.str()), v, raw);
+  } else {
+    r.set_raw[prefix] = raw;
+  }
+}
+
+void walk(Reader& r, const toml::table& table, const std::string& prefix, Config& config) {
+  // In the order of the file (toml++ keeps keys sorted by name), so the first problem reported
+  // is the first one a reader of the deck meets.
+  std::vector<std::pair<std::string, const toml::node*>> entries;
+  for (auto&& [k, v] : table) entries.emplace_back(std::string(k.str()), &v);
+  std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+    const auto &sa = a.second->source().begin, &sb = b.second->source().begin;
+    return sa.line != sb.line ? sa.line < sb.line : sa.column < sb.column;
+  });
+  for (const auto& [name, node] : entries) {
+    const toml::node& v = *node;
+    const std::string dotted = prefix.empty() ? name : prefix + "." + name;
+    const KeySpec* spec = find_key(dotted);
+    if (spec != nullptr) {
+      r.key = dotted;
+      r.seen[dotted] = &v;
+      spec->apply(r, v, config);
+      continue;
+    }
+    if (sections().count(dotted) != 0) {
+      const auto* sub = v.as_table();
+      if (sub == nullptr)
+        throw DeckError(one_line(r.where(dotted, &v) + "'" + dotted + "' is a section [" + dotted +
+                                 "], not a value (got " + value_text(v) + ")"));
+      walk(r, *sub, dotted, config);
+      continue;
+    }
+    fail_unknown(r, dotted, v, v.is_table());
+  }
+}
+
+std::vector<std::string> split_dots(const std::string& s) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t p = s.find('.', start);
+    parts.push_back(s.substr(start, p == std::string::npos ? std::string::npos : p - start));
+    if (p == std::string::npos) break;
+    start = p + 1;
+  }
+  return parts;
+}
+
+std::string trim(const std::string& s) {
+  const std::size_t b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  const std::size_t e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+// Inserts one `--set KEY=VALUE` into the parsed deck.
+void apply_override(Reader& r, toml::table& root, const std::string& text) {
+  const std::size_t eq = text.find('=');
+  const std::string example = " (for example --set model.embrace=135)";
+  if (eq == std::string::npos)
+    throw DeckError("--set '" + text + "': expected KEY=VALUE" + example);
+  const std::string key = trim(text.substr(0, eq));
+  const std::string raw = trim(text.substr(eq + 1));
+  const std::vector<std::string> parts = split_dots(key);
+  for (const std::string& p : parts)
+    if (p.empty() || p.find_first_of(" \t\"'[]") != std::string::npos)
+      throw DeckError("--set '" + text + "': '" + key + "' is not a dotted key path" + example);
+
+  // VALUE as a TOML value; anything that is not one (a bare word, a path) is a string.
+  toml::table parsed;
+  bool is_toml = false;
+  try {
+    parsed = toml::parse("v = " + raw + "\n", std::string_view("--set"));
+    is_toml = parsed.size() == 1 && parsed.contains("v");
+  } catch (const toml::parse_error&) {
+    is_toml = false;
+  }
+  if (!is_toml) {
+    parsed = toml::table{};
+    parsed.insert("v", raw);
+  }
+  const toml::node& value = *parsed.get("v");
+
+  toml::table* t = &root;
+  std::string path;
+  for (std::size_t k = 0; k + 1 < parts.size(); ++k) {
+    path += (k ? "." : "") + parts[k];
+    toml::node* existing = t->get(parts[k]);
+    if (existing == nullptr) {
+      t->insert(parts[k], toml::table{});
+      existing = t->get(parts[k]);
+    } else if (!existing->is_table()) {
+      throw DeckError("--set '" + text + "': '" + path + "' is a value, not a section");
+    }
+    t = existing->as_table();
+  }
+  if (const toml::node* existing = t->get(parts.back());
+      existing != nullptr && existing->is_table())
+    throw DeckError("--set '" + text + "': '" + key + "' is a section; set a key inside it (" +
+                    key + ".KEY=VALUE)");
+  value.visit([&](auto&& v) { t->insert_or_assign(parts.back(), v); });
+  mark_set_subtree(r, key, value, raw);
+}
+
+// Cross-key checks, after every key has been read.
+void check_together(const Reader& r, Config& c) {
+  auto given = [&](const std::string& k) { return r.seen.count(k) != 0; };
+  if (!given("model.kind"))
+    throw DeckError(r.source + ": missing required key 'model.kind' (one of " + join(kKinds) + ")");
+  if (c.model.kind == "polygons" && !given("model.file"))
+    throw DeckError(r.where("model.kind", r.seen.at("model.kind")) +
+                    "missing required key 'model.file' (model.kind = \"polygons\" reads its blocks "
+                    "from a polygon text file or a gmsh .msh file)");
+  if (c.load.base.signal == "file" && !given("load.base.file"))
+    throw DeckError(r.where("load.base.signal", r.seen.at("load.base.signal")) +
+                    "missing required key 'load.base.file' (load.base.signal = \"file\" reads a "
+                    "two-column accelerogram from it)");
+  // Input files the run will read must be there now, not an hour into a sweep.
+  auto readable = [&](const std::string& key, const std::string& path) {
+    std::error_code ec;
+    std::string why;
+    if (!fs::exists(path, ec)) {
+      why = "no such file";
+    } else if (fs::is_directory(path, ec)) {
+      why = "is a directory";
+    } else {
+      std::ifstream in(path);
+      if (!in) why = std::strerror(errno);
+    }
+    if (!why.empty()) {
+      const toml::node* n = r.seen.at(key);
+      throw DeckError(one_line(r.where(key, n) + key + " = " + value_text(*n) + ": cannot read '" +
+                               path + "' (" + why + ")"));
+    }
+  };
+  if (c.model.kind == "polygons") readable("model.file", c.model.file);
+  if (c.load.base.signal == "file") readable("load.base.file", c.load.base.file);
+  if (given("capacity.lambda_min") && given("capacity.lambda_max") &&
+      !(c.capacity.lambda_min == 0.0 && c.capacity.lambda_max == 0.0) &&
+      !(c.capacity.lambda_min < c.capacity.lambda_max)) {
+    const toml::node* n = r.seen.at("capacity.lambda_min");
+    throw DeckError(one_line(r.where("capacity.lambda_min", n) + "capacity.lambda_min = " +
+                             value_text(*n) + ": expected a number < capacity.lambda_max = " +
+                             value_text(*r.seen.at("capacity.lambda_max"))));
+  }
+}
+
+}  // namespace
+
+const std::vector<std::string>& known_keys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> out;
+    for (const KeySpec& k : key_table()) out.emplace_back(k.key);
+    return out;
+  }();
+  return keys;
+}
+
+Config parse_deck(const std::string& text, const std::string& source,
+                  const std::vector<std::string>& overrides, const std::string& deck_dir) {
+  Reader r;
+  r.source = source;
+  r.deck_dir = deck_dir.empty() ? "." : deck_dir;
+
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    throw DeckError(one_line(source + ":" + std::to_string(b.line) + ":" +
+                             std::to_string(b.column) +
+                             ": TOML syntax error: " + std::string(e.description())));
+  }
+  for (const std::string& o : overrides) apply_override(r, root, o);
+
+  Config config;
+  config.deck_path = source;
+  config.deck_dir = r.deck_dir;
+  walk(r, root, "", config);
+  check_together(r, config);
+  for (const auto& [k, n] : r.seen)
+    if (k.rfind("model.", 0) == 0) config.model.given.push_back(k.substr(6));
+  return config;
+}
+
+Config load_deck(const std::string& path, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw DeckError("cannot read deck '" + path + "': no such file");
+  if (fs::is_directory(path, ec))
+    throw DeckError("cannot read deck '" + path + "': is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw DeckError("cannot read deck '" + path + "': " + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw DeckError("cannot read deck '" + path + "': read error");
+  std::string dir = fs::path(path).parent_path().string();
+  if (dir.empty()) dir = ".";
+  return parse_deck(text.str(), path, overrides, dir);
+}
+
+}  // namespace voussoir

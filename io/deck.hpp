@@ -1,0 +1,30 @@
+#pragma once
+// Deck reading and validation (SPEC.md "Deck keys"). Every failure throws DeckError with one
+// line naming the key, the value and what is allowed (or the file, line and column of a TOML
+// syntax error); the program turns it into exit status 2.
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "io/config.hpp"
+
+namespace voussoir {
+
+struct DeckError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Reads the deck file, applies the `--set KEY=VALUE` overrides (dotted paths, same
+// validation as the file), validates every key and returns the result.
+Config load_deck(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// Same from text already in memory; `source` names it in messages; `deck_dir` resolves
+// relative paths.
+Config parse_deck(const std::string& text, const std::string& source,
+                  const std::vector<std::string>& overrides = {}, const std::string& deck_dir = ".");
+
+// Every dotted key the deck accepts ("model.kind", "load.base.signal", ...).
+const std::vector<std::string>& known_keys();
+
+}  // namespace voussoir

@@ -1,0 +1,110 @@
+#pragma once
+// HDF5 output of one run (SPEC.md section 5), plus an XDMF file beside it for ParaView.
+//
+// File layout (all floating-point data float64, integers int32 unless said):
+//   /                      attributes: complete (int32: 1 only once close_complete() ran),
+//                          format = "voussoir-run", version, kind, out_of_plane [m],
+//                          fields (comma list), snapshot_count, error (only if the run failed)
+//   /mesh/nodes            N x 2   reference node positions [m]
+//   /mesh/triangles        T x 3   node indices (0-based, counter-clockwise)
+//   /mesh/block            T       owning block of each triangle
+//   /mesh/node_block       N       owning block of each node
+//   /mesh/fixed            B       1 if the block is fixed (support), else 0
+//   /series/NAME           R       one row per append_series(): time [s], kinetic, strain,
+//                                  contact, damping_dissipated, friction_dissipated,
+//                                  external_work [J], max_displacement [m],
+//                                  active_contacts (int64), energy_balance_error [-]
+//   /series/control_displacement   R x C  (only if records carry control displacements;
+//                                  C fixed by the first record; attribute columns)
+//   /snapshots/NNNNNN/     attribute time [s]; datasets among position (N x 2) [m],
+//                          velocity (N x 2) [m/s], stress (T x 3: sxx, syy, sxy) [Pa],
+//                          only those requested in `fields`
+//
+// Completeness contract (SPEC.md: "no partial file left looking complete"):
+//   - open() removes any earlier `path` and its .xdmf, and writes to `path + ".tmp"` with
+//     complete = 0;
+//   - close_complete() closes the file, renames it to `path`, sets complete = 1 there and then
+//     writes the XDMF (which names the final `path`);
+//   - if the writer is destroyed (or close_incomplete() is called) first, the `.tmp` file is
+//     KEPT with complete = 0 (and an `error` attribute when a reason is given): the partial
+//     series and snapshots help to see what went wrong, and neither its name nor its flag
+//     can be taken for a finished run. No XDMF is written for it.
+//
+// Non-finite values are refused (std::runtime_error naming the field, the item and the time):
+// a NaN is never written silently. Errors of the HDF5 library or the file system throw
+// OutputError (io/json.hpp) naming the file.
+// Series rows are buffered in memory and written in blocks (every kSeriesBlock rows, at each
+// snapshot and at close), so appending a row costs no HDF5 call in the common case.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace voussoir {
+
+// One row of the time series.
+struct SeriesRecord {
+  double time = 0.0;                  // [s]
+  double kinetic = 0.0;               // [J] (per the model's out_of_plane thickness)
+  double strain = 0.0;                // [J]
+  double contact = 0.0;               // [J] penalty energy stored in overlaps
+  double damping_dissipated = 0.0;    // [J] cumulative
+  double friction_dissipated = 0.0;   // [J] cumulative
+  double external_work = 0.0;         // [J] cumulative (gravity, lambda g, base motion)
+  double max_displacement = 0.0;      // [m] largest free-node displacement magnitude
+  std::int64_t active_contacts = 0;   // contact pairs with overlap
+  double energy_balance_error = 0.0;  // relative, see EnergyLedger
+  // Optional: displacements of the control points, e.g. (ux, uy) of each point [m]. Empty =
+  // none; otherwise every record of the run carries the same number of values.
+  std::vector<double> control_displacements;
+};
+
+class RunWriter {
+ public:
+  RunWriter();
+  ~RunWriter();  // not completed: keeps `path + ".tmp"` with complete = 0
+  RunWriter(const RunWriter&) = delete;
+  RunWriter& operator=(const RunWriter&) = delete;
+
+  // Creates `path + ".tmp"` (and the parent folder if missing) and writes the mesh. `fields`
+  // chooses the snapshot datasets among "position", "velocity", "stress".
+  void open(const std::string& path, const Model& model, const std::vector<std::string>& fields);
+
+  // Optional, before the first append: names of the control-displacement columns.
+  void set_control_columns(const std::vector<std::string>& names);
+
+  void append_series(const SeriesRecord& record);
+
+  // Writes /snapshots/NNNNNN with the requested fields of the current model state.
+  // `stress_xx_yy_xy` holds (sxx, syy, sxy) of each triangle, interleaved (size 3 T) [Pa];
+  // it is read only when "stress" is among the fields (may be empty otherwise).
+  void write_snapshot(double time, const Model& model, const std::vector<double>& stress_xx_yy_xy);
+
+  // Finishes the run: the file appears at `path` with complete = 1, then the XDMF.
+  void close_complete();
+
+  // Error path made explicit: flushes what is buffered, records `reason` in the `error`
+  // attribute and closes, leaving only the `.tmp` file (complete = 0). Never throws.
+  void close_incomplete(const std::string& reason) noexcept;
+
+  bool is_open() const;
+  const std::string& path() const;  // the final path given to open()
+  std::string tmp_path() const;     // path + ".tmp"
+  std::string xdmf_path() const;    // path with its extension replaced by .xdmf
+  int snapshot_count() const;
+  std::int64_t series_rows() const;
+
+  static constexpr std::size_t kSeriesBlock = 256;  // rows buffered before an HDF5 write
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// "run.h5" -> "run.xdmf" (a path without extension gets ".xdmf" appended).
+std::string xdmf_path_for(const std::string& h5_path);
+
+}  // namespace voussoir

@@ -1,0 +1,132 @@
+#include "mesh/geometry.hpp"
+
+#include <algorithm>
+
+namespace voussoir {
+
+double distance_to_segment(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 ab = b - a;
+  const double len2 = dot(ab, ab);
+  if (len2 == 0.0) return distance(p, a);
+  const double s = std::clamp(dot(p - a, ab) / len2, 0.0, 1.0);
+  return distance(p, a + s * ab);
+}
+
+double outline_area(const Outline& outline) {
+  const std::size_t n = outline.size();
+  double twice = 0.0, segments = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const OutlineEdge& e = outline[i];
+    const Vec2 q = outline[(i + 1) % n].start;
+    twice += cross(e.start, q);
+    if (e.radius > 0.0)
+      segments += 0.5 * e.radius * e.radius * (e.sweep - std::sin(e.sweep));
+  }
+  return 0.5 * twice + segments;
+}
+
+Outline polygon_outline(const std::vector<Vec2>& vertices) {
+  Outline out;
+  out.reserve(vertices.size());
+  for (const Vec2& p : vertices) out.push_back(OutlineEdge{p, 0.0, {}, 0.0});
+  return out;
+}
+
+Outline mirror_outline(const Outline& outline) {
+  // Edge i runs p_i -> p_{i+1}. Mirrored and reversed (to stay counter-clockwise) it runs
+  // M(p_{i+1}) -> M(p_i): mirroring flips the sweep's sign and reversing flips it back.
+  const std::size_t n = outline.size();
+  Outline out;
+  out.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = n - 1 - k;
+    const OutlineEdge& e = outline[i];
+    OutlineEdge m;
+    m.start = mirror_x(outline[(i + 1) % n].start);
+    m.radius = e.radius;
+    m.centre = mirror_x(e.centre);
+    m.sweep = e.sweep;
+    out.push_back(m);
+  }
+  return out;
+}
+
+double polygon_area(const std::vector<Vec2>& polygon) {
+  double twice = 0.0;
+  const std::size_t n = polygon.size();
+  for (std::size_t i = 0; i < n; ++i) twice += cross(polygon[i], polygon[(i + 1) % n]);
+  return 0.5 * twice;
+}
+
+namespace {
+
+// Orientation of c relative to the line a->b: +1 left, -1 right, 0 collinear.
+int orient(Vec2 a, Vec2 b, Vec2 c) {
+  const double d = cross(b - a, c - a);
+  return (d > 0.0) - (d < 0.0);
+}
+
+bool on_segment(Vec2 a, Vec2 b, Vec2 p) {
+  return std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= p.y &&
+         p.y <= std::max(a.y, b.y);
+}
+
+bool segments_touch(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+  if (o1 != o2 && o3 != o4) return true;
+  return (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
+         (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b));
+}
+
+// Clips the convex polygon `poly` by the half-plane left of a->b.
+std::vector<Vec2> clip_left(const std::vector<Vec2>& poly, Vec2 a, Vec2 b) {
+  std::vector<Vec2> out;
+  const std::size_t n = poly.size();
+  const Vec2 ab = b - a;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 p = poly[i], q = poly[(i + 1) % n];
+    const double sp = cross(ab, p - a), sq = cross(ab, q - a);
+    if (sp >= 0.0) out.push_back(p);
+    if ((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0)) {
+      const double s = sp / (sp - sq);
+      out.push_back(p + s * (q - p));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool polygon_is_simple(const std::vector<Vec2>& polygon) {
+  const std::size_t n = polygon.size();
+  if (n < 3) return false;
+  for (std::size_t i = 0; i < n; ++i)
+    if (distance(polygon[i], polygon[(i + 1) % n]) == 0.0) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 a = polygon[i], b = polygon[(i + 1) % n];
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
+      const Vec2 c = polygon[j], d = polygon[(j + 1) % n];
+      if (adjacent) {
+        // Adjacent edges share one vertex; they must not fold back onto each other.
+        const Vec2 shared = j == i + 1 ? b : a;
+        const Vec2 u = (j == i + 1 ? a : b) - shared, v = (j == i + 1 ? d : c) - shared;
+        if (cross(u, v) == 0.0 && dot(u, v) > 0.0) return false;
+        continue;
+      }
+      if (segments_touch(a, b, c, d)) return false;
+    }
+  }
+  return true;
+}
+
+double triangle_overlap_area(const std::array<Vec2, 3>& t1, const std::array<Vec2, 3>& t2) {
+  std::vector<Vec2> poly(t1.begin(), t1.end());
+  if (polygon_area(poly) < 0.0) std::swap(poly[1], poly[2]);
+  std::array<Vec2, 3> clip = t2;
+  if (cross(clip[1] - clip[0], clip[2] - clip[0]) < 0.0) std::swap(clip[1], clip[2]);
+  for (int k = 0; k < 3 && poly.size() >= 3; ++k) poly = clip_left(poly, clip[k], clip[(k + 1) % 3]);
+  return poly.size() >= 3 ? std::max(0.0, polygon_area(poly)) : 0.0;
+}
+
+}  // namespace voussoir

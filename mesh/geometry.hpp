@@ -1,0 +1,67 @@
+#pragma once
+// Plane geometry used by the scene generators and their tests: small vector helpers, exact
+// block outlines made of straight and circular edges, polygon area and simplicity, and the
+// overlap area of two triangles.
+//
+// Exact outlines. A voussoir's intrados and extrados are circular arcs; its meshed outline is
+// the polygon through nodes placed exactly on those arcs, so the meshed area falls short of the
+// true area by the circular segments cut off by the chords (relative error ~ phi^2 / 12 for a
+// chord subtending phi). The generators therefore also record each block's exact outline
+// (edges that are straight or circular, with centre, radius and signed sweep) and
+// `outline_area` integrates it in closed form:
+//   A = shoelace(vertices) + sum over arc edges of (R^2 / 2) (phi - sin phi),
+// phi the signed sweep (counter-clockwise positive) of the arc from its start vertex to the
+// next vertex. The segment term is positive where the arc bulges out of a counter-clockwise
+// outline (phi > 0) and negative where it bulges in (phi < 0), so one formula serves both.
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace voussoir {
+
+inline Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
+inline Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
+inline Vec2 operator*(double s, Vec2 a) { return {s * a.x, s * a.y}; }
+inline double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
+inline double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
+inline double norm(Vec2 a) { return std::hypot(a.x, a.y); }
+inline double distance(Vec2 a, Vec2 b) { return std::hypot(a.x - b.x, a.y - b.y); }
+// Mirror image in the vertical axis x = 0 (exact: only the sign bit changes).
+inline Vec2 mirror_x(Vec2 p) { return {-p.x, p.y}; }
+// Point at angle `theta` [rad] on the circle (centre, radius).
+inline Vec2 on_circle(Vec2 centre, double radius, double theta) {
+  return {centre.x + radius * std::cos(theta), centre.y + radius * std::sin(theta)};
+}
+// Distance from p to the segment a-b.
+double distance_to_segment(Vec2 p, Vec2 a, Vec2 b);
+
+// One edge of an exact outline: from `start` to the next edge's start (cyclically).
+struct OutlineEdge {
+  Vec2 start;
+  double radius = 0.0;  // 0 = straight edge; else a circular arc of this radius [m]
+  Vec2 centre;          // arc centre [m]
+  double sweep = 0.0;   // signed angle swept from start to end about the centre [rad]
+};
+using Outline = std::vector<OutlineEdge>;
+
+// Area enclosed by a counter-clockwise exact outline [m2] (formula at the top of the file).
+double outline_area(const Outline& outline);
+// The straight-edged outline through the given vertices.
+Outline polygon_outline(const std::vector<Vec2>& vertices);
+// Mirror image in x = 0, still counter-clockwise.
+Outline mirror_outline(const Outline& outline);
+
+// Signed area of a polygon (positive when counter-clockwise) [m2].
+double polygon_area(const std::vector<Vec2>& polygon);
+// True when no two non-adjacent edges of the closed polygon touch or cross and no edge has
+// zero length.
+bool polygon_is_simple(const std::vector<Vec2>& polygon);
+
+// Area of the intersection of two triangles (each given in either orientation) [m2]:
+// Sutherland-Hodgman clipping of one convex polygon by the other.
+double triangle_overlap_area(const std::array<Vec2, 3>& t1, const std::array<Vec2, 3>& t2);
+
+}  // namespace voussoir

@@ -1,0 +1,214 @@
+// build_model: deck -> scene (mesh/scenes_*.cpp) -> meshed, finalized Model. Also the shared
+// helpers of the generators (element size, band cell choice, geometry errors) and the mesh
+// quality figure reported by `voussoir check`.
+
+#include "mesh/scene.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "io/deck.hpp"
+#include "mesh/scene_spec.hpp"
+
+namespace voussoir {
+
+namespace {
+
+// Largest mesh the generators agree to build: beyond it a typing slip in mesh.size would
+// exhaust memory before the user sees anything.
+constexpr double kMaxTriangles = 4e6;
+
+std::string format_number(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+[[noreturn]] void geometry_error(const Config& config, const std::string& key, double value,
+                                 const std::string& why) {
+  geometry_error(config, key, format_number(value), why);
+}
+
+[[noreturn]] void geometry_error(const Config& config, const std::string& key,
+                                 const std::string& value, const std::string& why) {
+  const std::string where = config.deck_path.empty() ? std::string() : config.deck_path + ": ";
+  throw DeckError(where + key + " = " + value + ": " + why);
+}
+
+double element_size(const Config& config, double reference) {
+  if (config.mesh.size > 0.0) return config.mesh.size;
+  const int n = config.mesh.through_thickness;
+  if (n < 1) geometry_error(config, "mesh.through_thickness", n, "expected an integer >= 1");
+  return reference / n;
+}
+
+void choose_band_cells(double t, double length, double curvature_ratio, double h, int* n,
+                       int* m) {
+  // Cell: b = t / n across, a = L / m along the centreline; along the intrados and extrados
+  // the cell is a (1 -+ q) long, q = t / (2 R) the curvature ratio of the tightest arc.
+  constexpr double kAspect = 1.8;  // largest side ratio accepted
+  constexpr double kTarget = 1.2;  // side ratio aimed at when refining
+  const double q = std::clamp(curvature_ratio, 0.0, 0.9);
+  *n = std::max(1, static_cast<int>(std::lround(t / h)));
+  *m = std::max(1, static_cast<int>(std::lround(length / h)));
+  const double a_in = length * (1.0 - q) / *m, a_out = length * (1.0 + q) / *m;
+  const double b = t / *n;
+  if (b > kAspect * a_in) {
+    *n = static_cast<int>(std::ceil(t / (kTarget * a_in)));
+  } else if (a_out > kAspect * b) {
+    *m = static_cast<int>(std::ceil(length * (1.0 + q) / (kTarget * b)));
+  }
+}
+
+Scene build_scene(const Config& config) {
+  const std::string& kind = config.model.kind;
+  Scene scene;
+  if (kind == "circular_arch" || kind == "basket_arch" || kind == "buttressed_arch") {
+    scene = build_arch_scene(config);
+  } else if (kind == "church") {
+    scene = build_church_scene(config);
+  } else if (kind == "block") {
+    scene = build_block_scene(config);
+  } else if (kind == "polygons") {
+    scene = build_polygons_scene(config);
+  } else {
+    geometry_error(config, "model.kind", "\"" + kind + "\"",
+                   "unknown scene (circular_arch, basket_arch, buttressed_arch, church, block, "
+                   "polygons)");
+  }
+  scene.kind = kind;
+  return scene;
+}
+
+Model mesh_scene(Scene& scene, const Config& config) {
+  // Refuse meshes that would not fit in memory before building them.
+  double estimate = 0.0;
+  for (const BlockSpec& b : scene.blocks) {
+    if (b.mesher == BlockSpec::Mesher::Polygon || b.mesher == BlockSpec::Mesher::SymmetricPolygon) {
+      const double area = std::abs(outline_area(b.outline));
+      estimate += 5.0 * area / (b.size * b.size);  // CGAL triangles ~ 0.2 size^2 each
+    } else if (b.mesher == BlockSpec::Mesher::Band && !b.columns.empty()) {
+      estimate += 2.0 * static_cast<double>(b.columns.size()) * b.columns[0].size();
+    }
+  }
+  if (estimate > kMaxTriangles) {
+    std::ostringstream why;
+    why << "would make about " << static_cast<long long>(estimate) << " triangles (limit "
+        << static_cast<long long>(kMaxTriangles) << "); use a coarser mesh";
+    if (config.mesh.size > 0.0)
+      geometry_error(config, "mesh.size", config.mesh.size, why.str());
+    geometry_error(config, "mesh.through_thickness", config.mesh.through_thickness, why.str());
+  }
+
+  // Mesh every block that is not a mirror first, then the mirrors.
+  for (BlockSpec& b : scene.blocks) {
+    switch (b.mesher) {
+      case BlockSpec::Mesher::Band:
+        b.mesh = mesh_band(b.columns);
+        break;
+      case BlockSpec::Mesher::Polygon:
+        b.mesh = triangulate_polygon(b.boundary, b.size);
+        break;
+      case BlockSpec::Mesher::SymmetricPolygon:
+        b.mesh = triangulate_symmetric(b.boundary, b.size);
+        break;
+      case BlockSpec::Mesher::Mirror:
+      case BlockSpec::Mesher::Given:
+        break;
+    }
+  }
+  for (BlockSpec& b : scene.blocks) {
+    if (b.mesher != BlockSpec::Mesher::Mirror) continue;
+    const BlockSpec& src = scene.blocks.at(b.mirror_of);
+    if (src.mesher == BlockSpec::Mesher::Mirror)
+      throw std::logic_error("mesh_scene: a mirror of a mirror");
+    b.mesh = mirror_mesh(src.mesh);
+  }
+
+  if (scene.rotation != 0.0)
+    for (BlockSpec& b : scene.blocks) rotate_mesh(b.mesh, scene.rotation);
+
+  if (scene.check_overlaps) {
+    // User-drawn blocks must not overlap: compare every pair whose boxes meet.
+    const std::size_t nb = scene.blocks.size();
+    std::vector<std::array<double, 4>> box(nb);
+    for (std::size_t i = 0; i < nb; ++i) {
+      box[i] = {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+      for (const Vec2& p : scene.blocks[i].mesh.points) {
+        box[i][0] = std::min(box[i][0], p.x);
+        box[i][1] = std::max(box[i][1], p.x);
+        box[i][2] = std::min(box[i][2], p.y);
+        box[i][3] = std::max(box[i][3], p.y);
+      }
+    }
+    for (std::size_t i = 0; i < nb; ++i)
+      for (std::size_t j = i + 1; j < nb; ++j) {
+        if (box[i][1] < box[j][0] || box[j][1] < box[i][0] || box[i][3] < box[j][2] ||
+            box[j][3] < box[i][2])
+          continue;
+        const double area = mesh_overlap_area(scene.blocks[i].mesh, scene.blocks[j].mesh);
+        const double ai = std::abs(outline_area(scene.blocks[i].outline));
+        const double aj = std::abs(outline_area(scene.blocks[j].outline));
+        if (area > 1e-9 * std::min(ai, aj)) {
+          std::ostringstream why;
+          why << "blocks " << i << " and " << j << " overlap (area " << area
+              << " m2); blocks may touch but not overlap";
+          geometry_error(config, "model.file", "'" + config.model.file + "'", why.str());
+        }
+      }
+  }
+
+  Model model;
+  model.kind = scene.kind;
+  for (const BlockSpec& b : scene.blocks)
+    add_block(model, boundary_loop(b.mesh), b.mesh.points, b.mesh.tris, b.fixed, b.role);
+  model.joints = scene.joints;
+  model.material.density = config.material.density;
+  model.material.young = config.material.young;
+  model.material.poisson = config.material.poisson;
+  model.material.plane_stress = config.material.plane == "stress";
+  model.out_of_plane = config.model.out_of_plane;
+  finalize_model(model);
+  return model;
+}
+
+Model build_model(const Config& config) {
+  Scene scene = build_scene(config);
+  return mesh_scene(scene, config);
+}
+
+Vec2 centreline_point(const Scene& scene, double s) {
+  double start = 0.0;
+  for (std::size_t k = 0; k < scene.centreline.size(); ++k) {
+    const ArcPiece& p = scene.centreline[k];
+    const double len = p.radius * std::abs(p.sweep);
+    if (s <= start + len || k + 1 == scene.centreline.size()) {
+      const double theta = p.start + std::copysign((s - start) / p.radius, p.sweep);
+      return on_circle(p.centre, p.radius, theta);
+    }
+    start += len;
+  }
+  throw std::logic_error("centreline_point: the scene has no centreline");
+}
+
+double worst_triangle_angle_deg(const Model& model) {
+  const Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  double worst = t.size() > 0 ? 180.0 : std::numeric_limits<double>::quiet_NaN();
+  for (Index e = 0; e < t.size(); ++e) {
+    const Vec2 a{n.x0[t.n0[e]], n.y0[t.n0[e]]}, b{n.x0[t.n1[e]], n.y0[t.n1[e]]},
+        c{n.x0[t.n2[e]], n.y0[t.n2[e]]};
+    worst = std::min(worst, triangle_min_angle_deg(a, b, c));
+  }
+  return worst;
+}
+
+}  // namespace voussoir

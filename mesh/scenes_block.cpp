@@ -1,0 +1,105 @@
+// The block scene (SPEC.md section 3): `stack` rectangular blocks `width` x `height` standing
+// on a fixed ground, optionally on an incline.
+//
+// Geometry, before the incline: the blocks are centred on x = 0, block k spans
+// y in [k height, (k + 1) height]; the ground is a fixed rectangle under them whose top is
+// y = 0, width / 2 deep, reaching width + stack x height beyond each side of the blocks (room
+// for a block to tip over or slide). Blocks are structured meshes (elements about
+// mesh.size, or min(width, height) / mesh.through_thickness); the ground is meshed half and
+// mirrored and keeps the bottom block's base nodes on its top face.
+// Incline: the whole scene (ground and blocks) is rotated counter-clockwise by `incline`
+// about the origin (the middle of the bottom block's base), so the ground rises to the right
+// and a sliding block moves towards -x. Gravity stays vertical.
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "mesh/scene_spec.hpp"
+
+namespace voussoir {
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kFixedCoarsening = 3.0;
+
+Vec2 rotate(Vec2 p, double c, double s) { return {c * p.x - s * p.y, s * p.x + c * p.y}; }
+
+}  // namespace
+
+Scene build_block_scene(const Config& config) {
+  const ModelConfig& mc = config.model;
+  const double w = mc.width, ht = mc.height, incline = mc.incline;
+  const int stack = mc.stack;
+  if (!(w > 0.0)) geometry_error(config, "model.width", w, "expected a width > 0 m");
+  if (!(ht > 0.0)) geometry_error(config, "model.height", ht, "expected a height > 0 m");
+  if (stack < 1) geometry_error(config, "model.stack", stack, "expected at least 1 block");
+  if (!(incline >= 0.0 && incline < 90.0))
+    geometry_error(config, "model.incline", incline, "expected an angle in [0, 90) degrees");
+
+  const double h = element_size(config, std::min(w, ht));
+  int n = 1, m = 1;  // n rows up the height, m columns across the width
+  choose_band_cells(ht, w, 0.0, h, &n, &m);
+
+  Scene scene;
+  scene.element_size = h;
+  scene.symmetric = incline == 0.0;
+  const double dx = w / (2.0 * m);
+  std::vector<double> xs(m + 1);
+  for (int j = 0; j <= m; ++j) xs[j] = (2 * j - m) * dx;  // xs[m - j] == -xs[j] exactly
+  for (int k = 0; k < stack; ++k) {
+    const double y0 = k * ht, y1 = (k + 1) * ht;
+    BlockSpec b;
+    b.role = "block";
+    b.mesher = BlockSpec::Mesher::Band;
+    for (int j = 0; j <= m; ++j) {
+      std::vector<Vec2> col(n + 1);
+      for (int i = 0; i <= n; ++i)
+        col[i] = {xs[j], i == n ? y1 : y0 + (i * ht) / n};
+      b.columns.push_back(std::move(col));
+    }
+    b.outline = polygon_outline({{xs[0], y0}, {xs[m], y0}, {xs[m], y1}, {xs[0], y1}});
+    scene.blocks.push_back(std::move(b));
+    if (k > 0)
+      scene.joints.push_back(Joint{k - 1, k, {xs[0], y0}, {xs[m], y0}, kNaN});
+  }
+
+  // Ground: right chain from (0, -depth) to (0, 0), keeping the base nodes of block 0.
+  const double reach = 0.5 * w + w + stack * ht, depth = 0.5 * w;
+  BlockSpec g;
+  g.role = "ground";
+  g.fixed = true;
+  g.mesher = BlockSpec::Mesher::SymmetricPolygon;
+  g.size = kFixedCoarsening * std::sqrt(2.0) * h;
+  PointChain ch;
+  ch.segment({0.0, -depth}, {reach, -depth}, kFixedCoarsening * h);
+  ch.segment({reach, -depth}, {reach, 0.0}, kFixedCoarsening * h);
+  ch.segment({reach, 0.0}, {xs[m], 0.0}, h);
+  for (int j = m; j >= 0 && xs[j] > 0.0; --j) ch.add(Vec2{xs[j], 0.0});
+  ch.add(Vec2{0.0, 0.0});
+  g.boundary = ch.points;
+  g.outline = polygon_outline({{-reach, -depth}, {reach, -depth}, {reach, 0.0}, {-reach, 0.0}});
+  const Index gi = static_cast<Index>(scene.blocks.size());
+  scene.blocks.push_back(std::move(g));
+  scene.joints.insert(scene.joints.begin(), Joint{gi, 0, {xs[0], 0.0}, {xs[m], 0.0}, kNaN});
+
+  if (incline > 0.0) {
+    scene.rotation = incline * kDeg;
+    const double c = std::cos(scene.rotation), s = std::sin(scene.rotation);
+    for (BlockSpec& b : scene.blocks)
+      for (OutlineEdge& e : b.outline) {
+        e.start = rotate(e.start, c, s);
+        e.centre = rotate(e.centre, c, s);
+      }
+    for (Joint& j : scene.joints) {
+      j.a = rotate(j.a, c, s);
+      j.b = rotate(j.b, c, s);
+    }
+  }
+  return scene;
+}
+
+}  // namespace voussoir

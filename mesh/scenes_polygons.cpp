@@ -1,0 +1,416 @@
+// The polygons scene (SPEC.md section 3): blocks read from a file, fixed ones listed by
+// `model.fixed` (0-based block indices).
+//
+// Two file formats, told apart by content (a gmsh file starts with `$MeshFormat`):
+//
+// 1. Polygon text file. One vertex `x y` per line (a comma may separate them); a block ends at
+//    a blank line or at a line `block`, which may also start the file; `#` starts a comment;
+//    a last vertex repeating the first is dropped. Each block must be a simple polygon (any
+//    orientation, convex or not) with at least three vertices; blocks may touch and share
+//    edges but not overlap. Blocks are numbered from 0 in file order. Example:
+//        # ground, then a block on it
+//        block
+//        -2 -0.5
+//         2 -0.5
+//         2  0
+//        -2  0
+//        block
+//        -0.25 0
+//         0.25 0
+//         0.25 1
+//        -0.25 1
+//    Each block is meshed by the constrained quality mesher with elements about mesh.size (or,
+//    without it, the smallest free block's narrowest bounding-box side / through_thickness).
+//    Edges are cut from their lexicographically smaller end, so two blocks that share an
+//    edge get the same nodes on it.
+//
+// 2. gmsh MSH 4.1 ASCII. Every 3-node triangle (element type 2) on a surface belongs to the
+//    block of that surface's (first) physical tag; blocks are numbered in ascending physical
+//    tag order. If no surface has a physical tag, each surface is one block (ascending surface
+//    tag). Lines and points are ignored; any other surface element (quadrangles, second-order
+//    triangles) is refused, and so is a block whose triangles do not form one piece without
+//    holes. The mesh is used as is (mesh.size does not apply).
+//
+// Joints: every pair of blocks whose outlines share a straight piece (collinear edges,
+// opposite directions, overlapping over more than 1e-9 of the edge) gets a Joint for the
+// shared piece (a = its end with the smaller x, then smaller y; position NaN).
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "mesh/scene_spec.hpp"
+
+namespace voussoir {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kFixedCoarsening = 3.0;
+
+struct FileError {
+  std::string what;
+};
+
+std::string trim(const std::string& s) {
+  std::size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  return s.substr(a, b - a);
+}
+
+// ---- polygon text files ----
+
+std::vector<std::vector<Vec2>> read_polygon_text(const std::string& text, const std::string& name) {
+  std::vector<std::vector<Vec2>> blocks;
+  std::vector<Vec2> cur;
+  std::vector<int> first_line;
+  int cur_line = 0;
+  auto close = [&]() {
+    if (!cur.empty()) {
+      blocks.push_back(cur);
+      first_line.push_back(cur_line);
+      cur.clear();
+    }
+  };
+  std::istringstream in(text);
+  std::string line;
+  for (int ln = 1; std::getline(in, line); ++ln) {
+    const std::size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    const std::string s = trim(line);
+    if (s.empty()) {
+      close();
+      continue;
+    }
+    std::string lower = s;
+    std::transform(lower.begin(), lower.end(), lower.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    if (lower.rfind("block", 0) == 0) {
+      if (trim(lower.substr(5)).size() != 0)
+        throw FileError{name + ":" + std::to_string(ln) + ": expected 'block' alone on its line"};
+      close();
+      continue;
+    }
+    std::string xy = s;
+    std::replace(xy.begin(), xy.end(), ',', ' ');
+    std::istringstream v(xy);
+    double x = 0.0, y = 0.0;
+    std::string extra;
+    if (!(v >> x >> y) || (v >> extra) || !std::isfinite(x) || !std::isfinite(y))
+      throw FileError{name + ":" + std::to_string(ln) + ": expected a vertex 'x y', got '" + s +
+                      "'"};
+    if (cur.empty()) cur_line = ln;
+    cur.push_back({x, y});
+  }
+  close();
+  if (blocks.empty()) throw FileError{name + ": no blocks (expected lines 'x y')"};
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    std::vector<Vec2>& p = blocks[b];
+    if (p.size() > 1 && p.front().x == p.back().x && p.front().y == p.back().y) p.pop_back();
+    const std::string where =
+        name + ":" + std::to_string(first_line[b]) + ": block " + std::to_string(b) + ": ";
+    if (p.size() < 3)
+      throw FileError{where + "a block needs at least 3 vertices, got " + std::to_string(p.size())};
+    if (!polygon_is_simple(p))
+      throw FileError{where + "the polygon is not simple (edges cross or touch, or a vertex repeats)"};
+    if (polygon_area(p) < 0.0) std::reverse(p.begin(), p.end());
+  }
+  return blocks;
+}
+
+// ---- gmsh MSH 4.1 ASCII ----
+
+struct GmshBlocks {
+  std::vector<TriMesh> meshes;
+  std::vector<int> tags;
+};
+
+GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
+  std::istringstream in(text);
+  std::string tok;
+  auto fail = [&](const std::string& why) { throw FileError{name + ": " + why}; };
+  std::map<int, int> surface_physical;  // surface tag -> first physical tag (absent: none)
+  std::map<std::size_t, std::array<double, 3>> nodes;
+  std::map<int, std::vector<std::array<std::size_t, 3>>> surface_tris;
+  bool format_ok = false;
+  while (in >> tok) {
+    if (tok == "$MeshFormat") {
+      double version = 0.0;
+      int binary = 0, dsize = 0;
+      if (!(in >> version >> binary >> dsize)) fail("unreadable $MeshFormat");
+      if (version < 4.1 || version >= 5.0)
+        fail("gmsh format " + std::to_string(version).substr(0, 3) +
+             " is not supported; save as MSH 4.1 ASCII (Mesh.MshFileVersion = 4.1)");
+      if (binary != 0) fail("binary gmsh files are not supported; save as ASCII");
+      format_ok = true;
+      in >> tok;  // $EndMeshFormat
+    } else if (tok == "$Entities") {
+      std::size_t np = 0, nc = 0, nsurf = 0, nvol = 0;
+      if (!(in >> np >> nc >> nsurf >> nvol)) fail("unreadable $Entities");
+      for (std::size_t i = 0; i < np; ++i) {
+        int tag, nphys;
+        double x, y, z;
+        if (!(in >> tag >> x >> y >> z >> nphys)) fail("unreadable point entity");
+        for (int k = 0; k < nphys; ++k) in >> tag;
+      }
+      for (std::size_t i = 0; i < nc + nsurf + nvol; ++i) {
+        int tag, nphys, nbound;
+        double bb[6];
+        if (!(in >> tag >> bb[0] >> bb[1] >> bb[2] >> bb[3] >> bb[4] >> bb[5] >> nphys))
+          fail("unreadable entity in $Entities");
+        for (int k = 0; k < nphys; ++k) {
+          int phys;
+          in >> phys;
+          if (i >= nc && i < nc + nsurf && k == 0) surface_physical[tag] = phys;
+        }
+        if (!(in >> nbound)) fail("unreadable entity in $Entities");
+        for (int k = 0; k < nbound; ++k) in >> tok;
+      }
+      in >> tok;  // $EndEntities
+    } else if (tok == "$Nodes") {
+      std::size_t nblocks = 0, nnodes = 0, mintag = 0, maxtag = 0;
+      if (!(in >> nblocks >> nnodes >> mintag >> maxtag)) fail("unreadable $Nodes");
+      for (std::size_t b = 0; b < nblocks; ++b) {
+        int dim, tag, parametric;
+        std::size_t count;
+        if (!(in >> dim >> tag >> parametric >> count)) fail("unreadable node block");
+        std::vector<std::size_t> ids(count);
+        for (auto& id : ids) in >> id;
+        for (std::size_t k = 0; k < count; ++k) {
+          std::array<double, 3> p{};
+          if (!(in >> p[0] >> p[1] >> p[2])) fail("unreadable node coordinates");
+          for (int q = 0; parametric && q < dim; ++q) in >> tok;
+          nodes[ids[k]] = p;
+        }
+      }
+      in >> tok;  // $EndNodes
+    } else if (tok == "$Elements") {
+      std::size_t nblocks = 0, nel = 0, mintag = 0, maxtag = 0;
+      if (!(in >> nblocks >> nel >> mintag >> maxtag)) fail("unreadable $Elements");
+      static const std::map<int, int> nodes_of = {{1, 2}, {2, 3}, {3, 4}, {4, 4}, {8, 3},
+                                                  {9, 6}, {10, 9}, {15, 1}, {16, 8}, {20, 9},
+                                                  {21, 10}, {26, 4}, {27, 5}, {28, 6}};
+      for (std::size_t b = 0; b < nblocks; ++b) {
+        int dim, tag, type;
+        std::size_t count;
+        if (!(in >> dim >> tag >> type >> count)) fail("unreadable element block");
+        const auto it = nodes_of.find(type);
+        if (it == nodes_of.end()) fail("unknown element type " + std::to_string(type));
+        if (dim == 2 && type != 2)
+          fail("surface " + std::to_string(tag) + " has elements of type " +
+               std::to_string(type) + "; only 3-node triangles (type 2) are supported");
+        if (dim == 3) fail("3D elements found; voussoir reads 2D triangle meshes");
+        for (std::size_t k = 0; k < count; ++k) {
+          std::size_t id;
+          in >> id;
+          std::array<std::size_t, 3> tri{};
+          for (int q = 0; q < it->second; ++q) {
+            std::size_t v;
+            if (!(in >> v)) fail("unreadable element");
+            if (dim == 2 && q < 3) tri[q] = v;
+          }
+          if (dim == 2) surface_tris[tag].push_back(tri);
+        }
+      }
+      in >> tok;  // $EndElements
+    } else if (tok.size() > 1 && tok[0] == '$' && tok.rfind("$End", 0) != 0) {
+      const std::string end = "$End" + tok.substr(1);
+      while (in >> tok && tok != end) {
+      }
+    }
+  }
+  if (!format_ok) fail("no $MeshFormat section");
+  if (surface_tris.empty()) fail("no triangles on any surface");
+
+  // Surfaces -> blocks.
+  bool any_phys = false, all_phys = true;
+  for (const auto& [s, tris] : surface_tris) {
+    const bool has = surface_physical.count(s) != 0;
+    any_phys = any_phys || has;
+    all_phys = all_phys && has;
+  }
+  if (any_phys && !all_phys)
+    fail("some surfaces have a physical tag and some do not; give each block a Physical Surface");
+  std::map<int, std::vector<std::array<std::size_t, 3>>> by_block;
+  for (const auto& [s, tris] : surface_tris) {
+    auto& dst = by_block[any_phys ? surface_physical.at(s) : s];
+    dst.insert(dst.end(), tris.begin(), tris.end());
+  }
+  double scale = 0.0;
+  for (const auto& [id, p] : nodes) scale = std::max({scale, std::abs(p[0]), std::abs(p[1])});
+  GmshBlocks out;
+  for (const auto& [tag, tris] : by_block) {
+    TriMesh mesh;
+    std::map<std::size_t, Index> local;
+    for (const auto& t : tris) {
+      std::array<Index, 3> tri{};
+      for (int q = 0; q < 3; ++q) {
+        const auto it = nodes.find(t[q]);
+        if (it == nodes.end()) fail("element refers to node " + std::to_string(t[q]) + " not in $Nodes");
+        if (std::abs(it->second[2]) > 1e-9 * std::max(scale, 1.0))
+          fail("node " + std::to_string(t[q]) + " has z = " + std::to_string(it->second[2]) +
+               "; the mesh must lie in the plane z = 0");
+        const auto [pos, fresh] = local.emplace(t[q], static_cast<Index>(mesh.points.size()));
+        if (fresh) mesh.points.push_back({it->second[0], it->second[1]});
+        tri[q] = pos->second;
+      }
+      const Vec2 a = mesh.points[tri[0]], b = mesh.points[tri[1]], c = mesh.points[tri[2]];
+      if (cross(b - a, c - a) == 0.0) fail("block with tag " + std::to_string(tag) + " has a degenerate triangle");
+      mesh.tris.push_back(tri);
+    }
+    out.meshes.push_back(std::move(mesh));
+    out.tags.push_back(tag);
+  }
+  return out;
+}
+
+// Shared straight pieces between the outlines of blocks i < j.
+void find_joints(Scene& scene, const std::vector<std::vector<Vec2>>& outlines) {
+  const std::size_t nb = outlines.size();
+  for (std::size_t i = 0; i < nb; ++i) {
+    for (std::size_t j = i + 1; j < nb; ++j) {
+      const auto& p = outlines[i];
+      const auto& q = outlines[j];
+      for (std::size_t e = 0; e < p.size(); ++e) {
+        const Vec2 a = p[e], b = p[(e + 1) % p.size()];
+        const Vec2 ab = b - a;
+        const double len = norm(ab);
+        for (std::size_t f = 0; f < q.size(); ++f) {
+          const Vec2 c = q[f], d = q[(f + 1) % q.size()];
+          const double tol = 1e-9 * std::max(len, distance(c, d));
+          if (std::abs(cross(ab, c - a)) / len > tol || std::abs(cross(ab, d - a)) / len > tol)
+            continue;
+          if (dot(ab, d - c) >= 0.0) continue;  // same direction: not facing each other
+          // Overlap of the parameter intervals along a-b.
+          const double sc = dot(c - a, ab) / (len * len), sd = dot(d - a, ab) / (len * len);
+          const double lo = std::max(0.0, std::min(sc, sd)), hi = std::min(1.0, std::max(sc, sd));
+          if ((hi - lo) * len <= tol) continue;
+          Vec2 u = lo == 0.0 ? a : (lo == sc ? c : (lo == sd ? d : a + lo * ab));
+          Vec2 v = hi == 1.0 ? b : (hi == sc ? c : (hi == sd ? d : a + hi * ab));
+          if (v.x < u.x || (v.x == u.x && v.y < u.y)) std::swap(u, v);
+          scene.joints.push_back(Joint{static_cast<Index>(i), static_cast<Index>(j), u, v, kNaN});
+        }
+      }
+    }
+  }
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError{"cannot open '" + path + "'"};
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+Scene build_polygons_scene(const Config& config) {
+  const ModelConfig& mc = config.model;
+  namespace fs = std::filesystem;
+  if (mc.file.empty())
+    geometry_error(config, "model.file", "\"\"", "model.kind = \"polygons\" needs a file of blocks");
+  fs::path path(mc.file);
+  if (path.is_relative() && !fs::exists(path) && !config.deck_dir.empty())
+    path = fs::path(config.deck_dir) / path;
+  const std::string shown = "'" + mc.file + "'";
+
+  Scene scene;
+  scene.check_overlaps = true;
+  std::vector<std::vector<Vec2>> outlines;
+  try {
+    const std::string text = read_file(path.string());
+    const std::size_t first = text.find_first_not_of(" \t\r\n");
+    const bool gmsh = first != std::string::npos && text.compare(first, 11, "$MeshFormat") == 0;
+    if (gmsh) {
+      GmshBlocks g = read_gmsh(text, path.string());
+      for (std::size_t b = 0; b < g.meshes.size(); ++b) {
+        std::vector<Vec2> loop;
+        try {
+          loop = boundary_loop(g.meshes[b]);
+        } catch (const std::invalid_argument& e) {
+          throw FileError{path.string() + ": block with tag " + std::to_string(g.tags[b]) +
+                          ": its triangles do not form one piece without holes (" + e.what() + ")"};
+        }
+        BlockSpec spec;
+        spec.mesher = BlockSpec::Mesher::Given;
+        spec.mesh = std::move(g.meshes[b]);
+        spec.outline = polygon_outline(loop);
+        outlines.push_back(loop);
+        scene.blocks.push_back(std::move(spec));
+      }
+    } else {
+      outlines = read_polygon_text(text, path.string());
+      for (const auto& p : outlines) {
+        BlockSpec spec;
+        spec.mesher = BlockSpec::Mesher::Polygon;
+        spec.outline = polygon_outline(p);
+        scene.blocks.push_back(std::move(spec));
+      }
+    }
+  } catch (const FileError& e) {
+    geometry_error(config, "model.file", shown, e.what);
+  }
+
+  const std::size_t nb = scene.blocks.size();
+  for (int f : mc.fixed)
+    if (f < 0 || static_cast<std::size_t>(f) >= nb)
+      geometry_error(config, "model.fixed", f,
+                     "no such block: the file has " + std::to_string(nb) + " blocks (indices 0.." +
+                         std::to_string(nb - 1) + ")");
+  for (std::size_t b = 0; b < nb; ++b) {
+    const bool fixed = std::find(mc.fixed.begin(), mc.fixed.end(), static_cast<int>(b)) != mc.fixed.end();
+    scene.blocks[b].fixed = fixed;
+    scene.blocks[b].role = fixed ? "ground" : "block";
+  }
+
+  // Element size from the smallest free block (all blocks if none is free).
+  double reference = std::numeric_limits<double>::infinity();
+  bool any_free = false;
+  for (const BlockSpec& b : scene.blocks) any_free = any_free || !b.fixed;
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (any_free && scene.blocks[b].fixed) continue;
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+    for (const Vec2& p : outlines[b]) {
+      x0 = std::min(x0, p.x);
+      x1 = std::max(x1, p.x);
+      y0 = std::min(y0, p.y);
+      y1 = std::max(y1, p.y);
+    }
+    reference = std::min({reference, x1 - x0, y1 - y0});
+  }
+  const double h = element_size(config, reference);
+  scene.element_size = h;
+  for (std::size_t b = 0; b < nb; ++b) {
+    BlockSpec& spec = scene.blocks[b];
+    if (spec.mesher != BlockSpec::Mesher::Polygon) continue;
+    const auto& p = outlines[b];
+    spec.size = (spec.fixed ? kFixedCoarsening : 1.0) * std::sqrt(2.0) * h;
+    // Cut each edge from its lexicographically smaller end so shared edges match.
+    for (std::size_t e = 0; e < p.size(); ++e) {
+      const Vec2 a = p[e], c = p[(e + 1) % p.size()];
+      const bool forward = a.x < c.x || (a.x == c.x && a.y < c.y);
+      std::vector<Vec2> cut;
+      append_segment(cut, forward ? a : c, forward ? c : a, h);
+      if (forward) {
+        spec.boundary.insert(spec.boundary.end(), cut.begin(), cut.end());
+      } else {
+        cut.push_back(a);  // from c .. a inclusive, reversed below, then drop c
+        std::reverse(cut.begin(), cut.end());
+        cut.pop_back();
+        spec.boundary.insert(spec.boundary.end(), cut.begin(), cut.end());
+      }
+    }
+  }
+  find_joints(scene, outlines);
+  return scene;
+}
+
+}  // namespace voussoir
