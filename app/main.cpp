@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "drivers/commands.hpp"
+#include "drivers/limit_command.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
 #include "voussoir/config.hpp"
@@ -62,6 +63,15 @@ int main(int argc, char** argv) {
                        "trial lambdas per bisection round, run in parallel (default 2)")
       ->check(CLI::Range(1, 64));
 
+  voussoir::LimitCommandOptions limit_opts;
+  CLI::App* limit =
+      app.add_subcommand("limit", "rigid-block limit analysis: lambda_la and its mechanism (LP)");
+  add_common(limit, deck, common);
+  limit->add_flag("--gravity-only", limit_opts.gravity_only,
+                  "only decide whether an admissible equilibrium exists under self-weight");
+  limit->add_option("--mechanism-out", limit_opts.mechanism_out,
+                    "write the block polygons and the mechanism as JSON (scripts/draw)");
+
   voussoir::SweepOptions sweep_opts;
   CLI::App* sweep = app.add_subcommand("sweep", "capacity over a grid of deck values");
   add_common(sweep, deck, common);
@@ -87,6 +97,7 @@ int main(int argc, char** argv) {
     if (check->parsed()) return voussoir::command_check(config, common, check_opts);
     if (run->parsed()) return voussoir::command_run(config, common, run_opts);
     if (capacity->parsed()) return voussoir::command_capacity(config, common, cap_opts);
+    if (limit->parsed()) return voussoir::command_limit(config, common, limit_opts);
   } catch (const voussoir::DeckError& e) {
     std::fprintf(stderr, "voussoir: error: %s\n", e.what());
     return 2;

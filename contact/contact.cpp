@@ -1,21 +1,25 @@
 // Contact stage: NBS broad phase (lazy), potential penalty narrow phase, Coulomb friction.
 //
-// Stable time step contribution (max_omega_squared). Model: a boundary edge of length L
-// pressed flat into a partner by a depth d. The overlap is a strip of area L d in the
-// sub-triangles next to the two faces, where |grad phi| = 3/h, so the pair force is
-// Ep thick g L d with g = 3/h_c + 3/h_t. With linear shape functions along the edge the
-// stiffness of the two nodes of the edge is Ep thick g [L/3 L/6; L/6 L/3], coupled with the
-// same matrix (negated) to the partner's nodes; its largest M^-1 K eigenvalue, the uniform
-// mode against the partner, is the Gershgorin row sum Ep thick g L / m (exact for equal
-// masses). A node on several boundary edges adds their rows. Hence, over free nodes i,
-//     omega^2 <= max_i  sum_{boundary edges k at i}  Ep thick (3/h_e(k) + 3/h_min) L_k / m_i
-// with h_e the smallest height of the triangle owning edge k (conservative for slivers, whose
-// gradient next to a short interior edge can be larger than next to the boundary edge) and
-// h_min the smallest such height over all participants (the unknown partner). Friction adds
-// a tangential spring whose row sum stays within the normal one (contact/friction.hpp), in
-// the perpendicular direction, so it does not raise the bound. Corner contacts (a vertex in a
-// face) are softer: the overlap grows like d^2, the stiffness like d. The explicit scheme is
-// stable for dt <= 2 / omega; core combines this with the element bound.
+// Stable time step contribution (max_omega_squared). Model: a boundary edge k of length L
+// pressed flat into a partner face by a depth d. The overlap is a strip of area L d lying in
+// the sub-triangles next to the two faces, where |grad phi| = 3/h (h: height of each triangle
+// over its face), so the pair force is Ep thick g L d with g = 3/h_c + 3/h_t. With linear
+// shape functions along the edge the stiffness of its two nodes is Ep thick g [L/3 L/6; L/6 L/3]
+// in the normal direction n, coupled (negated) to the partner's nodes; the Gershgorin row sum
+// of a node is Ep thick g L (L/3 + L/6 own, as much on the partner), and the largest
+// eigenvalue of M^-1 K, the two faces vibrating against each other, equals it for equal masses.
+// Friction adds at most half of that in the tangential direction e (contact/friction.hpp).
+// So each free node i gets the 2x2 matrix
+//     S_i = sum_{boundary edges k at i} Ep thick g_k L_k (n_k n_k^T + 1/2 e_k e_k^T)
+// and omega^2 <= max_i lambda_max(S_i) / m_i. Directions matter: along a flat face the edges
+// add up, at a corner the two faces act in perpendicular directions. For g_k the partner's
+// height is the smallest face height over the participants of the other blocks (a free block
+// can meet any of them). Against a fixed partner the true value is half of this (only one side
+// moves); corner contacts (a vertex in a face) are softer (overlap ~ d^2, stiffness ~ d).
+// Not covered: penetration deep enough to reach a partner's sub-triangles next to its interior
+// edges (slivers); the contact is broken long before. test_contact_blocks checks the bound
+// against the eigenvalues of finite-difference stiffness matrices. The explicit scheme is
+// stable for dt <= 2 / omega; core/step.cpp adds this omega^2 to the element one.
 
 #include "contact/contact.hpp"
 
@@ -40,9 +44,10 @@ struct ContactSystem::Impl {
   std::vector<IndexPair> pairs, next_pairs;
   std::vector<double> sx, sy, kt, next_sx, next_sy;
 
-  // Per triangle id (participants only): longest boundary edge [m], smallest height [m].
+  // Per triangle id (participants only): longest boundary edge [m] and the height over it [m].
   std::vector<double> edge_len, height;
-  double min_height = 0.0;
+  // Per block: smallest height of a participant over one of its boundary edges [m].
+  std::vector<double> block_min_height;
 
   std::int64_t active = 0;
   std::int64_t detections = 0;
@@ -76,24 +81,27 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
   s.active = 0;
   s.detections = 0;
 
-  // Reference geometry of the participants (for k_t and the stable step).
+  // Reference geometry of the participants: longest boundary edge and the height over it
+  // (for k_t), smallest face height per block (for the stable step).
   const Nodes& n = model.nodes;
   const Triangles& t = model.tris;
   s.edge_len.assign(t.size(), 0.0);
   s.height.assign(t.size(), 0.0);
-  s.min_height = std::numeric_limits<double>::infinity();
+  s.block_min_height.assign(model.blocks.size(), std::numeric_limits<double>::infinity());
   for (Index e : parts.tri) {
     const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
-    double longest = 0.0, longest_boundary = 0.0;
     for (int k = 0; k < 3; ++k) {
+      if (!(t.boundary[e] & (1u << k))) continue;
       const double len =
           std::hypot(n.x0[v[(k + 1) % 3]] - n.x0[v[k]], n.y0[v[(k + 1) % 3]] - n.y0[v[k]]);
-      longest = std::max(longest, len);
-      if (t.boundary[e] & (1u << k)) longest_boundary = std::max(longest_boundary, len);
+      const double h = 2.0 * t.area0[e] / len;
+      if (len > s.edge_len[e]) {
+        s.edge_len[e] = len;
+        s.height[e] = h;
+      }
+      double& bm = s.block_min_height[t.block[e]];
+      bm = std::min(bm, h);
     }
-    s.edge_len[e] = longest_boundary;
-    s.height[e] = 2.0 * t.area0[e] / longest;
-    s.min_height = std::min(s.min_height, s.height[e]);
   }
   s.ready = true;
 }
@@ -215,24 +223,53 @@ double ContactSystem::max_omega_squared(const Model& model) const {
   const Nodes& n = model.nodes;
   const Triangles& t = model.tris;
   const double ep = s.penalty * s.thickness;
-  // Row sums per free node, accumulated over the boundary edges of the participants.
-  std::vector<double> row(n.size(), 0.0);
+  const double tangential = 2.0 * kTangentialStiffnessRatio;  // row share of friction
+  // Smallest and second smallest block face heights, to get "smallest over the other blocks".
+  double h1 = std::numeric_limits<double>::infinity(), h2 = h1;
+  Index b1 = -1;
+  for (Index b = 0; b < static_cast<Index>(s.block_min_height.size()); ++b) {
+    const double h = s.block_min_height[b];
+    if (h < h1) {
+      h2 = h1;
+      h1 = h;
+      b1 = b;
+    } else if (h < h2) {
+      h2 = h;
+    }
+  }
+  // S_i = [sxx sxy; sxy syy] per node.
+  std::vector<double> sxx(n.size(), 0.0), sxy(n.size(), 0.0), syy(n.size(), 0.0);
   for (Index i = 0; i < parts.size(); ++i) {
     if (parts.fixed[i]) continue;
     const Index e = parts.tri[i];
+    const double h_partner = parts.block[i] == b1 ? h2 : h1;
+    if (!std::isfinite(h_partner)) continue;
     const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
-    const double g = 3.0 / s.height[e] + 3.0 / s.min_height;
     for (int k = 0; k < 3; ++k) {
       if (!(t.boundary[e] & (1u << k))) continue;
       const Index i0 = v[k], i1 = v[(k + 1) % 3];
-      const double len = std::hypot(n.x0[i1] - n.x0[i0], n.y0[i1] - n.y0[i0]);
-      row[i0] += ep * g * len;
-      row[i1] += ep * g * len;
+      const double dx = n.x0[i1] - n.x0[i0], dy = n.y0[i1] - n.y0[i0];
+      const double len = std::hypot(dx, dy);
+      const double g = 3.0 * len / (2.0 * t.area0[e]) + 3.0 / h_partner;
+      const double ex = dx / len, ey = dy / len;  // edge direction = tangent; normal (-ey, ex)
+      const double k_len = ep * g * len;
+      const double axx = k_len * (ey * ey + tangential * ex * ex);
+      const double axy = k_len * (-ex * ey + tangential * ex * ey);
+      const double ayy = k_len * (ex * ex + tangential * ey * ey);
+      for (Index node : {i0, i1}) {
+        sxx[node] += axx;
+        sxy[node] += axy;
+        syy[node] += ayy;
+      }
     }
   }
   double w2 = 0.0;
-  for (Index i = 0; i < n.size(); ++i)
-    if (row[i] > 0.0 && n.inv_mass[i] > 0.0) w2 = std::max(w2, row[i] * n.inv_mass[i]);
+  for (Index i = 0; i < n.size(); ++i) {
+    if (!(n.inv_mass[i] > 0.0)) continue;
+    const double mean = 0.5 * (sxx[i] + syy[i]);
+    const double dev = std::hypot(0.5 * (sxx[i] - syy[i]), sxy[i]);
+    w2 = std::max(w2, (mean + dev) * n.inv_mass[i]);
+  }
   return w2;
 }
 

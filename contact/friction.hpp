@@ -20,13 +20,17 @@
 // and -f on t at the same point (overlap centroid), so forces and moments balance exactly.
 //
 // Tangential stiffness. k_t = kTangentialStiffnessRatio x Ep thick (3/h_c + 3/h_t) min(L_c, L_t)
-// [N/m]: the normal stiffness of a flat contact, Ep thick (|grad phi_c| + |grad phi_t|) x
-// contact length, for the longest contact the two triangles can make (L: longest boundary
-// edge, h: smallest height), times 1/2. Constant per pair, so that 1/2 k_t s^2 is an honest
-// energy (a k_t following the overlap length would change the stored energy without work).
-// The ratio 1/2 keeps the tangential row sum of the stiffness (2 k_t N_i <= Ep thick g L)
-// within the normal one, so the stable step from max_omega_squared covers friction too;
-// the elastic slip at stick is f/k_t ~ 1e-10 m for masonry blocks, far below what matters.
+// [N/m], with L the longest boundary edge of a triangle and h its height over that edge:
+// Ep thick (|grad phi_c| + |grad phi_t|) x contact length is the normal stiffness of a flat
+// contact between the two faces, for the longest contact the two triangles can make. Constant
+// per pair, so that 1/2 k_t s^2 is an honest energy (a k_t following the overlap length would
+// change the stored energy without work). Ratio 1/4: the tangential spring acts at one point
+// with shape-function weights N_i, so its stiffness row sum at a node is 2 k_t N_i <= half the
+// normal row sum Ep thick g L of the same edge; max_omega_squared (contact/contact.cpp) adds
+// it in the tangential direction. Rejected 1/2: the tangential row would equal the normal one
+// and raise the bound at corner nodes (two perpendicular faces) from 1.5 to 2 times one face's
+// row, a 15% shorter stable step, for nothing. The elastic slip at stick, f_t / k_t, is
+// ~1e-9 m for masonry blocks, far below anything that matters.
 
 #include <cmath>
 #include <vector>
@@ -36,8 +40,8 @@
 
 namespace voussoir {
 
-// Tangential / normal penalty stiffness ratio (dimensionless; 0.5, see above).
-inline constexpr double kTangentialStiffnessRatio = 0.5;
+// Tangential / normal penalty stiffness ratio (dimensionless; 1/4, see above).
+inline constexpr double kTangentialStiffnessRatio = 0.25;
 
 struct FrictionResult {
   Vec2 force;               // tangential force on c [N] (minus this on t)
@@ -53,7 +57,7 @@ struct FrictionResult {
 inline FrictionResult coulomb_friction(Vec2 normal_force, Vec2 du, Vec2 slip, double kt,
                                        double mu) {
   FrictionResult r;
-  const double fn = std::hypot(normal_force.x, normal_force.y);
+  const double fn = std::sqrt(normal_force.x * normal_force.x + normal_force.y * normal_force.y);
   if (!(fn > 0.0)) return r;
   const double ex = -normal_force.y / fn, ey = normal_force.x / fn;
   const double s_trial = (slip.x + du.x) * ex + (slip.y + du.y) * ey;

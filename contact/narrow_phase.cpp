@@ -14,43 +14,56 @@ struct Poly {
   double x[kMaxPoly], y[kMaxPoly];
 };
 
+// A polygon whose vertices carry the barycentric coordinates l[m] of one triangle (affine
+// functions, so intersection points interpolate them exactly up to round-off).
+struct BaryPoly {
+  int n = 0;
+  double x[kMaxPoly], y[kMaxPoly], l[3][kMaxPoly];
+};
+
 // Affine function a + b x + c y.
 struct Affine {
   double a = 0.0, b = 0.0, c = 0.0;
   double operator()(double x, double y) const { return a + b * x + c * y; }
 };
 
-inline Affine operator-(const Affine& p, const Affine& q) {
-  return {p.a - q.a, p.b - q.b, p.c - q.c};
-}
-
-// Barycentric coordinates of a triangle as affine functions (local coordinates):
-// lam[m] = cross(p[m+2] - p[m+1], x - p[m+1]) / (2 A), zero on the edge opposite vertex m.
-struct Bary {
-  Affine lam[3];
+// Edge functions of a triangle (local coordinates): e[m] = cross(p[m+2] - p[m+1], x - p[m+1]),
+// zero on the edge opposite vertex m, positive inside (counter-clockwise); twice the area.
+struct Edges {
+  Affine e[3];
   double twice_area = 0.0;
 };
 
-inline Bary barycentric(const double* px, const double* py) {
-  Bary t;
+inline Edges edge_functions(const double* px, const double* py) {
+  Edges t;
   t.twice_area = (px[1] - px[0]) * (py[2] - py[0]) - (py[1] - py[0]) * (px[2] - px[0]);
-  if (!(t.twice_area > 0.0)) return t;
-  const double inv = 1.0 / t.twice_area;
   for (int m = 0; m < 3; ++m) {
     const int i = (m + 1) % 3, j = (m + 2) % 3;
     const double ex = px[j] - px[i], ey = py[j] - py[i];
     // cross(e, x - p_i) = -ey x + ex y + (ey px_i - ex py_i)
-    t.lam[m] = {(ey * px[i] - ex * py[i]) * inv, -ey * inv, ex * inv};
+    t.e[m] = {ey * px[i] - ex * py[i], -ey, ex};
   }
   return t;
+}
+
+// Barycentric coordinates lam[m] = e[m] / (2 A).
+struct Bary {
+  Affine lam[3];
+};
+
+inline Bary barycentric(const Edges& t) {
+  const double inv = 1.0 / t.twice_area;
+  Bary b;
+  for (int m = 0; m < 3; ++m) b.lam[m] = {t.e[m].a * inv, t.e[m].b * inv, t.e[m].c * inv};
+  return b;
 }
 
 // Keeps the part of convex `in` where f >= 0 (Sutherland-Hodgman, one line).
 inline void clip(const Poly& in, const Affine& f, Poly& out) {
   out.n = 0;
   if (in.n == 0) return;
-  double fp = f(in.x[in.n - 1], in.y[in.n - 1]);
   double px = in.x[in.n - 1], py = in.y[in.n - 1];
+  double fp = f(px, py);
   for (int k = 0; k < in.n; ++k) {
     const double qx = in.x[k], qy = in.y[k], fq = f(qx, qy);
     if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
@@ -70,34 +83,28 @@ inline void clip(const Poly& in, const Affine& f, Poly& out) {
   }
 }
 
-// Splits convex `in` by the line f = 0 into the parts f <= 0 (neg) and f >= 0 (pos).
-inline void split(const Poly& in, const Affine& f, Poly& neg, Poly& pos) {
-  neg.n = pos.n = 0;
+// Keeps the part of convex `in` where l[b] - l[a] >= 0, i.e. lambda_a <= lambda_b.
+inline void clip_le(const BaryPoly& in, int a, int b, BaryPoly& out) {
+  out.n = 0;
   if (in.n == 0) return;
-  double px = in.x[in.n - 1], py = in.y[in.n - 1];
-  double fp = f(px, py);
-  for (int k = 0; k < in.n; ++k) {
-    const double qx = in.x[k], qy = in.y[k], fq = f(qx, qy);
+  int p = in.n - 1;
+  double fp = in.l[b][p] - in.l[a][p];
+  for (int q = 0; q < in.n; ++q) {
+    const double fq = in.l[b][q] - in.l[a][q];
     if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
       const double s = fp / (fp - fq);
-      const double ix = px + s * (qx - px), iy = py + s * (qy - py);
-      neg.x[neg.n] = pos.x[pos.n] = ix;
-      neg.y[neg.n] = pos.y[pos.n] = iy;
-      ++neg.n;
-      ++pos.n;
-    }
-    if (fq <= 0.0) {
-      neg.x[neg.n] = qx;
-      neg.y[neg.n] = qy;
-      ++neg.n;
+      out.x[out.n] = in.x[p] + s * (in.x[q] - in.x[p]);
+      out.y[out.n] = in.y[p] + s * (in.y[q] - in.y[p]);
+      for (int m = 0; m < 3; ++m) out.l[m][out.n] = in.l[m][p] + s * (in.l[m][q] - in.l[m][p]);
+      ++out.n;
     }
     if (fq >= 0.0) {
-      pos.x[pos.n] = qx;
-      pos.y[pos.n] = qy;
-      ++pos.n;
+      out.x[out.n] = in.x[q];
+      out.y[out.n] = in.y[q];
+      for (int m = 0; m < 3; ++m) out.l[m][out.n] = in.l[m][q];
+      ++out.n;
     }
-    px = qx;
-    py = qy;
+    p = q;
     fp = fq;
   }
 }
@@ -107,7 +114,8 @@ struct Moments {
   double area = 0.0, sx = 0.0, sy = 0.0;
 };
 
-inline Moments moments(const Poly& p) {
+template <class P>
+inline Moments moments(const P& p) {
   Moments m;
   if (p.n < 3) return m;
   double a2 = 0.0, sx6 = 0.0, sy6 = 0.0;
@@ -118,8 +126,8 @@ inline Moments moments(const Poly& p) {
     sy6 += (p.y[j] + p.y[k]) * cr;
   }
   m.area = 0.5 * a2;
-  m.sx = sx6 / 6.0;
-  m.sy = sy6 / 6.0;
+  m.sx = sx6 * (1.0 / 6.0);
+  m.sy = sy6 * (1.0 / 6.0);
   return m;
 }
 
@@ -130,9 +138,7 @@ struct Field {
   double phi = 0.0;
 };
 
-inline void add_region(const Bary& T, int m, const Poly& region, Field& f) {
-  const Moments mo = moments(region);
-  if (!(mo.area > 0.0)) return;
+inline void add_region(const Bary& T, int m, const Moments& mo, Field& f) {
   const Affine& l = T.lam[m];
   const double gx = 3.0 * l.b, gy = 3.0 * l.c;
   f.g[0][0] += gx * mo.area;
@@ -148,30 +154,45 @@ inline int argmin3(double a, double b, double c) {
   return a <= b ? (a <= c ? 0 : 2) : (b <= c ? 1 : 2);
 }
 
-inline Field field_over(const Bary& T, const Poly& P) {
+// Region m of P (where lambda_m is the smallest coordinate) for m = 0, 1, 2. The region that
+// holds P's centroid (usually the large one) is P minus the other two, so only two regions are
+// clipped (two lines each).
+inline Field field_over(const Bary& T, const Poly& P, const Moments& mp) {
   Field f;
-  // Fast path: every vertex of P in the same sub-triangle (a convex region), so all of P is.
+  BaryPoly a;
+  a.n = P.n;
   int m0 = -1;
   bool same = true;
-  for (int k = 0; k < P.n && same; ++k) {
+  for (int k = 0; k < P.n; ++k) {
     const double x = P.x[k], y = P.y[k];
-    const int m = argmin3(T.lam[0](x, y), T.lam[1](x, y), T.lam[2](x, y));
+    a.x[k] = x;
+    a.y[k] = y;
+    for (int m = 0; m < 3; ++m) a.l[m][k] = T.lam[m](x, y);
+    const int m = argmin3(a.l[0][k], a.l[1][k], a.l[2][k]);
     if (m0 < 0) m0 = m;
-    same = (m == m0);
+    same = same && m == m0;
   }
+  // Fast path: every vertex in the same sub-triangle (a convex region), so all of P is.
   if (same) {
-    add_region(T, m0, P, f);
+    add_region(T, m0, mp, f);
     return f;
   }
-  // lambda_0 >= lambda_1: min is lambda_1 or lambda_2; else lambda_0 or lambda_2.
-  Poly a, b, r1, r2;
-  split(P, T.lam[0] - T.lam[1], b, a);
-  split(a, T.lam[1] - T.lam[2], r1, r2);  // r1: lambda_1 <= lambda_2, r2: lambda_2 < lambda_1
-  add_region(T, 1, r1, f);
-  add_region(T, 2, r2, f);
-  split(b, T.lam[0] - T.lam[2], r1, r2);  // r1: lambda_0 <= lambda_2
-  add_region(T, 0, r1, f);
-  add_region(T, 2, r2, f);
+  const double cx = mp.sx / mp.area, cy = mp.sy / mp.area;
+  const int big = argmin3(T.lam[0](cx, cy), T.lam[1](cx, cy), T.lam[2](cx, cy));
+  Moments rest = mp;
+  BaryPoly tmp, region;
+  for (int m = 0; m < 3; ++m) {
+    if (m == big) continue;
+    clip_le(a, m, (m + 1) % 3, tmp);
+    clip_le(tmp, m, (m + 2) % 3, region);
+    const Moments mo = moments(region);
+    if (!(mo.area > 0.0)) continue;
+    add_region(T, m, mo, f);
+    rest.area -= mo.area;
+    rest.sx -= mo.sx;
+    rest.sy -= mo.sy;
+  }
+  if (rest.area > 0.0) add_region(T, big, rest, f);
   return f;
 }
 
@@ -189,24 +210,28 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
     tx[k] = t[k].x - ox;
     ty[k] = t[k].y - oy;
   }
-  const Bary bc = barycentric(cx, cy), bt = barycentric(tx, ty);
-  if (!(bc.twice_area > 0.0) || !(bt.twice_area > 0.0)) return out;
+  const Edges ec = edge_functions(cx, cy), et = edge_functions(tx, ty);
+  if (!(ec.twice_area > 0.0) || !(et.twice_area > 0.0)) return out;
 
-  // Overlap P = t clipped by the three edges of c (lambda_m^c >= 0).
+  // Overlap P = t clipped by the three edges of c (no division before we know it is there).
   Poly p0, p1;
   p0.n = 3;
   for (int k = 0; k < 3; ++k) {
     p0.x[k] = tx[k];
     p0.y[k] = ty[k];
   }
-  clip(p0, bc.lam[0], p1);
-  clip(p1, bc.lam[1], p0);
-  clip(p0, bc.lam[2], p1);
+  clip(p0, ec.e[0], p1);
+  if (p1.n < 3) return out;
+  clip(p1, ec.e[1], p0);
+  if (p0.n < 3) return out;
+  clip(p0, ec.e[2], p1);
   const Poly& P = p1;
+  if (P.n < 3) return out;
   const Moments mp = moments(P);
-  if (P.n < 3 || !(mp.area > 0.0)) return out;
+  if (!(mp.area > 0.0)) return out;
 
-  const Field fc = field_over(bc, P), ft = field_over(bt, P);
+  const Bary bc = barycentric(ec), bt = barycentric(et);
+  const Field fc = field_over(bc, P, mp), ft = field_over(bt, P, mp);
 
   // Nodal forces: f_i(c) = Ep [(G_c - G_t) l_i^c - Phi_t grad N_i^c], and symmetrically.
   double d[2][3];

@@ -2,6 +2,7 @@
 
 #include "core/cst.hpp"
 
+#include <algorithm>
 #include <cstddef>
 
 namespace voussoir {
@@ -12,7 +13,13 @@ Stress2 triangle_cauchy_stress(const Model& model, Index e, const CstLaw& law) {
 
 namespace {
 
-// The element loop; kViscous: read and update the per-triangle viscous Piola buffer.
+// Triangles per chunk of the element loop: gather node data into small local arrays, run the
+// kernel over the chunk (no indirect writes, so it vectorizes: 4 triangles per AVX2 op), then
+// scatter the forces. Measured ~1.5x over the plain gather-compute-scatter loop (damped,
+// 1e5 triangles); 16, 32 and 64 perform alike.
+constexpr int kChunk = 32;
+
+// The element loop; kViscous: read and update the viscous Piola buffer (ledger).
 template <bool kViscous>
 ElementStageResult element_loop(Model& model, const CstLaw& law, double* __restrict viscous) {
   Nodes& nodes = model.nodes;
@@ -33,30 +40,55 @@ ElementStageResult element_loop(Model& model, const CstLaw& law, double* __restr
   const double* __restrict b11 = tris.b11.data();
   const double* __restrict area0 = tris.area0.data();
   const double thickness = model.out_of_plane;
+  const std::size_t nt = std::size_t(tris.size());
+
+  // Chunk buffers: node data of the three corners, and the forces on them.
+  alignas(64) double cx[3][kChunk], cy[3][kChunk], cvx[3][kChunk], cvy[3][kChunk];
+  alignas(64) double cfx[3][kChunk], cfy[3][kChunk];
 
   double energy = 0.0, power = 0.0, previous_power = 0.0;
-  // Triangles of one block are contiguous: one flat loop per free block.
+  // Triangles of one block are contiguous: flat loops per free block.
   for (const Block& block : model.blocks) {
     if (block.fixed) continue;
-    const Index begin = block.first_tri, end = block.first_tri + block.tri_count;
-    for (Index e = begin; e < end; ++e) {
-      const Index i0 = n0[e], i1 = n1[e], i2 = n2[e];
-      TriangleState s;
-      s.x[0] = x[i0], s.x[1] = x[i1], s.x[2] = x[i2];
-      s.y[0] = y[i0], s.y[1] = y[i1], s.y[2] = y[i2];
-      s.vx[0] = vx[i0], s.vx[1] = vx[i1], s.vx[2] = vx[i2];
-      s.vy[0] = vy[i0], s.vy[1] = vy[i1], s.vy[2] = vy[i2];
-      const EdgeInverse b{b00[e], b01[e], b10[e], b11[e]};
-      const CstForce f = cst_force(s, b, area0[e] * thickness, law);
-      fx[i0] += f.fx[0], fx[i1] += f.fx[1], fx[i2] += f.fx[2];
-      fy[i0] += f.fy[0], fy[i1] += f.fy[1], fy[i2] += f.fy[2];
-      energy += f.energy;
-      power += f.damping_power;
-      if constexpr (kViscous) {
-        double* __restrict pv = viscous + 4 * std::size_t(e);
-        previous_power +=
-            pv[0] * f.rate[0] + pv[1] * f.rate[1] + pv[2] * f.rate[2] + pv[3] * f.rate[3];
-        pv[0] = f.viscous[0], pv[1] = f.viscous[1], pv[2] = f.viscous[2], pv[3] = f.viscous[3];
+    const Index end = block.first_tri + block.tri_count;
+    for (Index c0 = block.first_tri; c0 < end; c0 += kChunk) {
+      const int len = int(std::min<Index>(kChunk, end - c0));
+      for (int j = 0; j < len; ++j) {  // gather
+        const Index e = c0 + j, i0 = n0[e], i1 = n1[e], i2 = n2[e];
+        cx[0][j] = x[i0], cx[1][j] = x[i1], cx[2][j] = x[i2];
+        cy[0][j] = y[i0], cy[1][j] = y[i1], cy[2][j] = y[i2];
+        cvx[0][j] = vx[i0], cvx[1][j] = vx[i1], cvx[2][j] = vx[i2];
+        cvy[0][j] = vy[i0], cvy[1][j] = vy[i1], cvy[2][j] = vy[i2];
+      }
+      double en = 0.0, pw = 0.0, pp = 0.0;
+#pragma omp simd reduction(+ : en, pw, pp)
+      for (int j = 0; j < len; ++j) {  // compute
+        const Index e = c0 + j;
+        TriangleState s;
+        for (int a = 0; a < 3; ++a) {
+          s.x[a] = cx[a][j], s.y[a] = cy[a][j];
+          s.vx[a] = cvx[a][j], s.vy[a] = cvy[a][j];
+        }
+        const EdgeInverse b{b00[e], b01[e], b10[e], b11[e]};
+        const CstForce f = cst_force(s, b, area0[e] * thickness, law);
+        for (int a = 0; a < 3; ++a) cfx[a][j] = f.fx[a], cfy[a][j] = f.fy[a];
+        en += f.energy;
+        pw += f.damping_power;
+        if constexpr (kViscous) {
+          // Power of the previous step's viscous stress at the current velocities; then keep
+          // this step's.
+          double* __restrict pv = viscous + e;
+          pp += pv[0] * f.rate[0] + pv[nt] * f.rate[1] + pv[2 * nt] * f.rate[2] +
+                pv[3 * nt] * f.rate[3];
+          pv[0] = f.viscous[0], pv[nt] = f.viscous[1];
+          pv[2 * nt] = f.viscous[2], pv[3 * nt] = f.viscous[3];
+        }
+      }
+      energy += en, power += pw, previous_power += pp;
+      for (int j = 0; j < len; ++j) {  // scatter
+        const Index e = c0 + j, i0 = n0[e], i1 = n1[e], i2 = n2[e];
+        fx[i0] += cfx[0][j], fx[i1] += cfx[1][j], fx[i2] += cfx[2][j];
+        fy[i0] += cfy[0][j], fy[i1] += cfy[1][j], fy[i2] += cfy[2][j];
       }
     }
   }

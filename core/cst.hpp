@@ -29,15 +29,21 @@
 // no iteration); the stable time step accounts for that lag (see cst_frequency_bound).
 //
 // Nodal forces. With the element energy V0 W(F), the internal force on node a is
-//     f_a = -dE/dx_a = -V0 (P + P_v) g_a,     f0 = -(f1 + f2)
-// so the three forces sum to zero (momentum) and, for the elastic part, their moment about
-// any point vanishes (P F^T = F S F^T is symmetric).
+//     f_a = -d(V0 W)/dx_a (+ viscous) = -V0 (P + P_v) g_a,     f0 = -(f1 + f2)
+// so the three forces sum to zero (momentum) and their moment about any point vanishes
+// ((P + P_v) F^T = J (sigma + sigma_v) is symmetric).
+//
+// Why SVK: the simplest objective hyperelastic law, exact rotations, and at masonry strains
+// (1e-4) indistinguishable from linear elasticity. Known limit, accepted: SVK softens under
+// compressive stretch below ~0.58 and has no barrier against inversion; a triangle that
+// crushed that far means the run is already wrong (too soft blocks or a far too large dt).
 //
 // Units: lengths m, velocities m/s, stresses Pa, eta Pa s, V0 m3 (area x out-of-plane
 // thickness), forces N, energy J, power W.
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/model.hpp"
 
@@ -127,11 +133,14 @@ inline CstForce cst_force(const TriangleState& s, const EdgeInverse& b, double v
 
   // Viscous term. With M = sym(Fdot cof(F)^T) = J D (no division) and s = eta / J:
   //   P_v = eta D cof(F) = s M cof(F),   power = V0 J eta D:D = V0 s M:M.
-  // The division runs beside the products instead of ahead of them (shorter dependency chain).
-  // A degenerate or inverted triangle (J <= 0) gets no damping rather than a division by 0.
-  if (law.eta > 0.0) {
+  // The division runs beside the products instead of ahead of them (shorter dependency chain),
+  // and the term has no branch (eta = 0 just gives zeros) so the element stage vectorizes
+  // across triangles. A degenerate or inverted triangle (J <= 0) gets no damping rather than
+  // a division by 0.
+  {
     const double J = k.f00 * k.f11 - k.f01 * k.f10;
-    const double sc = J > 0.0 ? law.eta / J : 0.0;
+    const double j_pos = J > 0.0 ? J : std::numeric_limits<double>::infinity();
+    const double sc = law.eta / j_pos;  // 0 when J <= 0 (branch-free)
     // cof(F) = [[f11, -f10], [-f01, f00]].
     const double m00 = k.d00 * k.f11 - k.d01 * k.f10;
     const double m11 = -k.d10 * k.f01 + k.d11 * k.f00;
@@ -275,8 +284,10 @@ struct ElementStageResult {
 
 // Element stage: adds the CST forces of every triangle of a free block into nodes.fx/fy
 // (triangles of fixed blocks are skipped: their nodes never move).
-// `viscous` (4 per triangle, or nullptr) holds V0 P_v of the previous step on entry and of
-// this step on return; it feeds the exact damping work of the ledger.
+// `viscous` (4 x triangle count, component-major: viscous[k * ntri + e] is component k of
+// V0 P_v of triangle e, row-major k = 00, 01, 10, 11; or nullptr) holds the previous step's
+// viscous stress on entry and this step's on return; it feeds the exact damping work of the
+// ledger (ElementStageResult::previous_damping_power).
 ElementStageResult add_element_forces(Model& model, const CstLaw& law, double* viscous = nullptr);
 
 // Largest element bounds over the triangles of free blocks (all blocks if none is free).

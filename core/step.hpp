@@ -47,8 +47,9 @@ struct Simulation {
   StepContext ctx;
   StageTimers timers;
   long long step = 0;
-  // Per-triangle V0 P_v of the last damped step (4 per triangle, row-major) for the exact
-  // damping work of the ledger (core/step.cpp); sized by advance(), empty when undamped.
+  // V0 P_v of every triangle at the last damped step (layout in core/cst.hpp
+  // add_element_forces) for the exact damping work of the ledger; sized by advance(), empty
+  // when undamped.
   std::vector<double> viscous_piola;
 };
 

@@ -98,6 +98,9 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   TrialResult r;
   r.lambda = lambda;
   double rest_since = -1.0;
+  // Motion measure m(t) = max over blocks of max(d / d_collapse, |rotation| / rot_collapse)
+  // (1 = collapse) sampled in time, for the timeout decision.
+  std::vector<double> measure;
   bool decided = false;
   while (!decided) {
     const double t = sim.ctx.time - t_start;
@@ -115,6 +118,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
     }
     r.max_displacement = dmax;
     r.max_rotation = rmax;
+    measure.push_back(std::max(dmax / d_collapse, rmax / crit.collapse_rotation));
     if (dmax > d_collapse || rmax > crit.collapse_rotation) {
       r.collapsed = true;
       r.reason = dmax > d_collapse ? "displacement" : "rotation";
@@ -131,7 +135,14 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
         rest_since = -1.0;
       }
       if (!decided && elapsed >= crit.max_time) {
-        r.collapsed = v >= v_rest;
+        // Near lambda* the restoring stiffness of the mechanism vanishes, so motion decays
+        // ever more slowly (critical slowing down) and neither criterion fires. Decide by the
+        // trend: collapsed when the motion measure now exceeds by 10% its largest value over
+        // the first two thirds of the trial (a mechanism that keeps opening), stable when it
+        // stays bounded (an oscillation about a displaced equilibrium).
+        const size_t cut = measure.size() * 2 / 3;
+        const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
+        r.collapsed = measure.back() > 1.1 * earlier;
         r.reason = "timeout";
         decided = true;
       }

@@ -31,9 +31,11 @@ inline double norm(Vec2 a) { return std::hypot(a.x, a.y); }
 inline double distance(Vec2 a, Vec2 b) { return std::hypot(a.x - b.x, a.y - b.y); }
 // Mirror image in the vertical axis x = 0 (exact: only the sign bit changes).
 inline Vec2 mirror_x(Vec2 p) { return {-p.x, p.y}; }
-// Point at angle `theta` [rad] on the circle (centre, radius).
+// Point at angle `theta` [rad] on the circle (centre, radius). Explicit fma so that the
+// rounding is the same wherever it is inlined (GCC's default -ffp-contract=fast fuses
+// a + r cos at some call sites and not at others).
 inline Vec2 on_circle(Vec2 centre, double radius, double theta) {
-  return {centre.x + radius * std::cos(theta), centre.y + radius * std::sin(theta)};
+  return {std::fma(radius, std::cos(theta), centre.x), std::fma(radius, std::sin(theta), centre.y)};
 }
 // Distance from p to the segment a-b.
 double distance_to_segment(Vec2 p, Vec2 a, Vec2 b);

@@ -114,11 +114,15 @@ Scene build_church_scene(const Config& config) {
   for (double s : spans)
     if (!(s > 0.0)) geometry_error(config, "model.spans", s, "every span must be > 0 m");
   if (!(t > 0.0)) geometry_error(config, "model.thickness", t, "expected a thickness > 0 m");
-  if (!(outer >= t))
+  // A support exactly as wide as its springings (pier = 2t, outer = t, the default church)
+  // is allowed: the extrados springing points then meet at the pier's middle (or the outer
+  // face) and are made the same point.
+  constexpr double kTight = 1e-9;
+  if (!(outer >= t * (1.0 - kTight)))
     geometry_error(config, "model.outer_width", outer,
                    "an outer buttress must carry its arch's springing joint: it must be at least "
                    "model.thickness = " + fmt(t) + " m wide");
-  if (ns > 1 && !(pier >= 2.0 * t))
+  if (ns > 1 && !(pier >= 2.0 * t * (1.0 - kTight)))
     geometry_error(config, "model.pier_width", pier,
                    "too narrow for its two springings: a pier carries two springing joints of "
                    "model.thickness = " + fmt(t) + " m each, so it must be at least " +
@@ -194,12 +198,25 @@ Scene build_church_scene(const Config& config) {
     const double crl = xm - c, cll = xm + c;  // x of C_R and C_L
     auto rho = [&](int i) { return i == n ? re : ri + (i * t) / n; };
     // side +1: right half, -1: left half. Column J at theta = J D / m.
+    // Point at angle th and radius r on one half. Explicit fma: GCC contracts a + r cos into
+    // an fma at some call sites and not at others (-ffp-contract=fast is its default), which
+    // would break the bit-exact mirror pairs; with fma(-r, c, cll) = -fma(r, c, -cll) the
+    // left half is the exact mirror image of the right half of the mirrored span.
+    auto polar = [&](int side, double r, double th) -> Vec2 {
+      const double y = std::fma(r, std::sin(th), height);
+      return side > 0 ? Vec2{std::fma(r, std::cos(th), crl), y}
+                      : Vec2{std::fma(-r, std::cos(th), cll), y};
+    };
+    // Extrados springing points: t beyond the faces, or exactly the meeting point when the
+    // support is just wide enough (see the validation above).
+    auto tight = [&](const Support& sp) { return sp.xr - sp.xl <= (&sp == &sup.front() || &sp == &sup.back() ? 1.0 : 2.0) * t * (1.0 + kTight); };
+    const Support &sl = sup[s], &sr = sup[s + 1];
+    const double xe_left = !tight(sl) ? a - t : (&sl == &sup.front() ? sl.xl : 0.5 * (sl.xl + sl.xr));
+    const double xe_right = !tight(sr) ? b + t : (&sr == &sup.back() ? sr.xr : 0.5 * (sr.xl + sr.xr));
     auto point = [&](int side, long long j, int i) -> Vec2 {
+      if (j == 0 && i == n) return {side > 0 ? xe_right : xe_left, height};
       if (j == 0) return side > 0 ? Vec2{b + (i * t) / n, height} : Vec2{a - (i * t) / n, height};
-      const double th = static_cast<double>(j) * dtheta / m;
-      const double r = rho(i);
-      if (side > 0) return {crl + r * std::cos(th), height + r * std::sin(th)};
-      return {cll - r * std::cos(th), height + r * std::sin(th)};
+      return polar(side, rho(i), static_cast<double>(j) * dtheta / m);
     };
     auto column = [&](int side, long long j) {
       std::vector<Vec2> col(n + 1);
@@ -238,11 +255,7 @@ Scene build_church_scene(const Config& config) {
       auto arc = [&](int side, double r, double th0, double th1, std::vector<Vec2>& out) {
         // Points strictly between th0 and th1 on the arc of radius r (parts no longer than h).
         const int parts = std::max(1, static_cast<int>(std::ceil(r * std::abs(th1 - th0) / h)));
-        for (int q = 1; q < parts; ++q) {
-          const double th = th0 + (th1 - th0) * q / parts;
-          out.push_back(side > 0 ? Vec2{crl + r * std::cos(th), height + r * std::sin(th)}
-                                 : Vec2{cll - r * std::cos(th), height + r * std::sin(th)});
-        }
+        for (int q = 1; q < parts; ++q) out.push_back(polar(side, r, th0 + (th1 - th0) * q / parts));
       };
       std::vector<Vec2> bnd;
       bnd.push_back(fr[0]);
@@ -415,7 +428,8 @@ Scene build_church_scene(const Config& config) {
           }
           if (same) partner = static_cast<Index>(j);
         }
-        if (partner < 0) throw std::logic_error("church: no mirror partner for a left block");
+        if (partner < 0)
+          throw std::logic_error("church: no mirror partner for block " + std::to_string(i));
         b.mesher = BlockSpec::Mesher::Mirror;
         b.mirror_of = partner;
         b.outline = mirror_outline(scene.blocks[partner].outline);

@@ -265,15 +265,17 @@ static void drop(double mu, double damping_factor, double* worst_balance, double
   Simulation sim = make_sim(std::move(m), mu, damping_factor);
   *worst_balance = 0.0;
   *worst_gain = -1e300;
+  std::int64_t most_active = 0;
   const long long n = std::llround(0.15 / sim.ctx.dt);
   for (long long k = 0; k < n; ++k) {
     advance(sim);
     *worst_balance = std::max(*worst_balance, sim.ledger.balance_error());
     const EnergyLedger& l = sim.ledger;
     *worst_gain = std::max(*worst_gain, (l.stored() - l.external_work) / l.max_energy);
+    most_active = std::max(most_active, sim.contact.active_pairs());
   }
   EXPECT_GT(sim.ledger.max_energy, 0.0);
-  EXPECT_GT(sim.contact.active_pairs(), 0);
+  EXPECT_GT(most_active, 0);  // it did hit the ground
 }
 
 TEST(ContactBlocks, DroppedBlockConservesEnergyWithoutDissipation) {
@@ -293,16 +295,29 @@ TEST(ContactBlocks, DroppedBlockNeverGainsEnergy) {
 }
 
 // The contact part of the stable step: max_omega_squared bounds the largest eigenvalue of
-// M^-1 K_contact (K by central differences of the contact forces) and is not absurdly larger.
+// M^-1 K (K: contact stiffness by central differences of the contact forces, the normal part
+// through the positions and the friction part through the slip increment dt v) and is not
+// wildly larger. Scenes: a block on the ground; two stacked blocks; two blocks side by side
+// with non-matching meshes pressed into each other.
 TEST(ContactBlocks, OmegaEstimateBoundsTrueContactFrequency) {
-  for (int scene = 0; scene < 2; ++scene) {
-    Model m = scene == 0 ? block_scene(0.5, 0.5, 1, 2, 2) : block_scene(0.5, 0.4, 2, 3, 2);
-    Simulation sim = make_sim(std::move(m), 0.0, 1.0);
-    // Press every block into the one below by 1e-4 m (the stiffness of a flat overlap does not
-    // depend on its depth).
+  for (int scene = 0; scene < 3; ++scene) {
+    Model m;
+    if (scene == 0) m = block_scene(0.5, 0.5, 1, 2, 2);
+    if (scene == 1) m = block_scene(0.5, 0.4, 2, 3, 2);
+    if (scene == 2) {
+      m = block_scene(0.4, 0.5, 0, 1, 1);
+      add_rectangle(m, -0.4, 0.0, 0.4, 0.5, 2, 2, false, "block");
+      add_rectangle(m, 0.0, 0.0, 0.3, 0.5, 3, 4, false, "block");
+    }
+    Simulation sim = make_sim(std::move(m), 0.6, 1.0);
+    // Press the blocks into their neighbours by 1e-4 m (the stiffness of a flat overlap does
+    // not depend on its depth).
     Nodes& n = sim.model.nodes;
-    for (Index i = 0; i < n.size(); ++i)
-      if (n.block[i] > 0) n.y[i] -= 1e-4 * n.block[i];
+    for (Index i = 0; i < n.size(); ++i) {
+      if (n.block[i] == 0) continue;
+      if (scene < 2) n.y[i] -= 1e-4 * n.block[i];
+      if (scene == 2) n.y[i] -= 1e-4, n.x[i] += (n.block[i] == 1 ? 1e-4 : -1e-4);
+    }
     sim.contact.detect(sim.model);
     std::vector<Index> dof_node;
     for (Index i = 0; i < n.size(); ++i)
@@ -320,9 +335,9 @@ TEST(ContactBlocks, OmegaEstimateBoundsTrueContactFrequency) {
         f[2 * k + 1] = mm.nodes.fy[dof_node[k]];
       }
     };
-    Eigen::MatrixXd K(N, N);
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(N, N);
     Eigen::VectorXd fp(N), fm(N);
-    const double step = 1e-7;
+    const double step = 1e-7, slip = 1e-10;
     for (int j = 0; j < N; ++j) {
       double& coord = (j % 2 == 0 ? n.x : n.y)[dof_node[j / 2]];
       coord += step;
@@ -331,6 +346,14 @@ TEST(ContactBlocks, OmegaEstimateBoundsTrueContactFrequency) {
       forces(fm);
       coord += step;
       K.col(j) = -(fp - fm) / (2 * step);
+      // Friction: a slip increment u is dt v; stick, so the force is linear in it.
+      double& vel = (j % 2 == 0 ? n.vx : n.vy)[dof_node[j / 2]];
+      vel += slip / sim.ctx.dt;
+      forces(fp);
+      vel -= 2 * slip / sim.ctx.dt;
+      forces(fm);
+      vel += slip / sim.ctx.dt;
+      K.col(j) += -(fp - fm) / (2 * slip);
     }
     Eigen::VectorXd inv_sqrt_m(N);
     for (int k = 0; k < N; ++k) inv_sqrt_m[k] = std::sqrt(n.inv_mass[dof_node[k / 2]]);
@@ -342,6 +365,6 @@ TEST(ContactBlocks, OmegaEstimateBoundsTrueContactFrequency) {
     std::printf("scene %d: contact omega^2 true %.4e, estimate %.4e (ratio %.2f)\n", scene,
                 lambda_max, estimate, estimate / lambda_max);
     EXPECT_GE(estimate, lambda_max);
-    EXPECT_LT(estimate, 8.0 * lambda_max);
+    EXPECT_LT(estimate, 4.0 * lambda_max);
   }
 }

@@ -285,11 +285,21 @@ TEST(DeckErrors, UnknownKeySuggestsNearest) {
   // A known key in the wrong section points to the right one.
   expect_deck_error(std::string(kMinimal) + "friction = 0.5\n",
                     {"unknown key 'model.friction'", "did you mean 'contact.friction'"});
+  expect_deck_error(std::string(kMinimal) + "frction = 0.5\n",
+                    {"unknown key 'model.frction'", "did you mean 'contact.friction'"});
   // Far from anything: no suggestion.
   const std::string far = expect_deck_error(std::string(kMinimal) + "zzzzzzzzqqq = 1\n",
                                             {"unknown key 'model.zzzzzzzzqqq'"});
   EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
   expect_deck_error("title = \"x\"\n" + std::string(kMinimal), {"unknown key 'title'"});
+}
+
+TEST(DeckErrors, FirstProblemInFileOrderIsReported) {
+  // toml++ keeps keys sorted by name; the error on the earlier line must still win.
+  expect_deck_error(std::string(kMinimal) + "voussoirs = 0\nembrace = 400\n",
+                    {"deck.toml:3:", "model.voussoirs = 0"});
+  expect_deck_error(std::string(kMinimal) + "embrace = 400\nvoussoirs = 0\n",
+                    {"deck.toml:3:", "model.embrace = 400"});
 }
 
 TEST(DeckErrors, UnknownSection) {

@@ -1,0 +1,65 @@
+// Full explicit step (broad phase when needed, CST elements + damping, contact + friction,
+// loads, integration) on the shipped semicircular arch (cases/circular_arch.toml: 11
+// voussoirs, t/R = 0.2, mu = 0.6) under gravity, one thread. The mesh density is varied with
+// mesh.through_thickness to get about 50, 100 and 1000 triangles. The arch first settles for
+// 2000 steps so that the joints are in contact, then the timed loop runs.
+//
+// Run: OMP_NUM_THREADS=1 build-*/bench_step
+// Figure of merit: "tri_steps_per_s" = triangles x steps / wall second (target >= 3e7).
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "core/step.hpp"
+#include "drivers/setup.hpp"
+#include "io/deck.hpp"
+
+using namespace voussoir;
+
+namespace {
+
+Simulation arch(int through_thickness) {
+  const Config config = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml",
+                                  {"mesh.through_thickness=" + std::to_string(through_thickness)});
+  Simulation sim = make_simulation(config);
+  for (int k = 0; k < 2000; ++k) advance(sim);
+  return sim;
+}
+
+void BM_StepCircularArch(benchmark::State& state) {
+  Simulation sim = arch(static_cast<int>(state.range(0)));
+  for (auto _ : state) advance(sim);
+  const double tris = static_cast<double>(sim.model.tris.size());
+  state.counters["triangles"] = tris;
+  state.counters["candidates"] = static_cast<double>(sim.contact.candidate_pairs());
+  state.counters["active"] = static_cast<double>(sim.contact.active_pairs());
+  state.counters["tri_steps_per_s"] =
+      benchmark::Counter(tris, benchmark::Counter::kIsIterationInvariantRate);
+}
+// through_thickness 1, 2 and 6 give about 50, 100 and 1000 triangles (the counter reports the
+// exact number).
+BENCHMARK(BM_StepCircularArch)->Arg(1)->Arg(2)->Arg(6)->Unit(benchmark::kMicrosecond);
+
+// Where the time goes (stage timers of advance()), for the 1000-triangle arch.
+void BM_StepStages(benchmark::State& state) {
+  Simulation sim = arch(static_cast<int>(state.range(0)));
+  sim.timers = StageTimers{};
+  sim.timers.enabled = true;
+  long long steps = 0;
+  for (auto _ : state) {
+    advance(sim);
+    ++steps;
+  }
+  const StageTimers& t = sim.timers;
+  const double per = 1e9 / static_cast<double>(steps);
+  state.counters["broad_ns"] = t.broad * per;
+  state.counters["elements_ns"] = t.elements * per;
+  state.counters["contact_ns"] = t.contact * per;
+  state.counters["loads_ns"] = t.loads * per;
+  state.counters["integrate_ns"] = t.integrate * per;
+}
+BENCHMARK(BM_StepStages)->Arg(6)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

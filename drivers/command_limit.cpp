@@ -1,0 +1,160 @@
+// `voussoir limit DECK`: rigid-block limit analysis on the blocks of the deck's model — the
+// collapse load factor lambda_la and its mechanism, or (--gravity-only) whether an admissible
+// equilibrium exists under self-weight alone. Friction: contact.friction (associative, so an
+// upper bound where sliding governs); gravity: load.gravity.
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "drivers/limit_command.hpp"
+#include "io/deck.hpp"
+#include "io/json.hpp"
+#include "limit/limit_analysis.hpp"
+#include "mesh/scene.hpp"
+
+namespace voussoir {
+
+// Meshed model geometry as written by `voussoir check --mesh-out` (drivers/check.cpp).
+nlohmann::json model_geometry_json(const Model& model);
+
+namespace {
+
+nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json mechanism_json(const LimitResult& res) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const MechanismJoint& m : res.mechanism)
+    out.push_back({{"joint", m.joint},
+                   {"interface", m.interface},
+                   {"blocks", {m.block_a, m.block_b}},
+                   {"kind", m.kind},
+                   {"side", m.side},
+                   {"x", m.x},
+                   {"y", m.y},
+                   {"position_deg", number_or_null(m.position_deg)},
+                   {"opening_a", m.opening_a},
+                   {"opening_b", m.opening_b},
+                   {"slip", m.slip}});
+  return out;
+}
+
+nlohmann::json interfaces_json(const LimitResult& res) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t k = 0; k < res.interfaces.size(); ++k) {
+    const Interface& f = res.interfaces[k];
+    nlohmann::json j = {{"blocks", {f.block_a, f.block_b}},
+                        {"joint", f.joint},
+                        {"a", {f.a.x, f.a.y}},
+                        {"b", {f.b.x, f.b.y}},
+                        {"normal", {f.normal.x, f.normal.y}},
+                        {"position_deg", number_or_null(f.position_deg)}};
+    if (k < res.forces.size()) {
+      const InterfaceForces& F = res.forces[k];
+      j["forces"] = {{"normal_a", F.normal_a},
+                     {"shear_a", F.shear_a},
+                     {"normal_b", F.normal_b},
+                     {"shear_b", F.shear_b}};
+    }
+    out.push_back(j);
+  }
+  return out;
+}
+
+}  // namespace
+
+int command_limit(const Config& config, const CommonOptions& common,
+                  const LimitCommandOptions& opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Model model = build_model(config);
+  const double model_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double mu = config.contact.friction;
+  const double g = config.load.gravity;
+  if (!(g > 0.0))
+    throw DeckError(config.deck_path + ": load.gravity = " + std::to_string(g) +
+                    ": limit analysis needs gravity > 0 (the load is lambda x weight)");
+  if (!common.quiet)
+    std::fprintf(stderr, "limit: %zu blocks, model built in %.2f s; solving the LP...\n",
+                 model.blocks.size(), model_s);
+  const LimitResult res = limit_analysis(model, mu, g, opts.gravity_only);
+
+  std::printf("deck        %s\n", config.deck_path.c_str());
+  std::printf("model       %s: %d free blocks, %zu interfaces (mu = %.4g)\n", model.kind.c_str(),
+              res.free_blocks, res.interfaces.size(), mu);
+  std::printf("LP          %d rows x %d columns, %d iterations, %s, %.3f s\n", res.rows,
+              res.columns, res.iterations, res.exact ? "exact check passed" : "no exact check",
+              res.wall_s);
+  if (opts.gravity_only) {
+    std::printf("gravity     %s: %s\n", res.admissible ? "admissible" : "NOT admissible",
+                res.admissible ? "an equilibrium with no tension and |S| <= mu N exists"
+                               : "no equilibrium under self-weight without tension");
+  } else if (res.status == "optimal") {
+    std::printf("lambda_la   %.6f  (rigid blocks, no tension, associative friction)\n",
+                res.lambda_la);
+    if (res.lambda_la < 0.0)
+      std::printf("            negative: the model is not admissible under self-weight alone\n");
+    for (const MechanismJoint& m : res.mechanism) {
+      std::printf("  %-10s interface %d", m.kind.c_str(), m.interface);
+      if (m.joint >= 0) std::printf(" (joint %d)", m.joint);
+      std::printf(" blocks %d-%d", m.block_a, m.block_b);
+      if (std::isfinite(m.position_deg)) std::printf(" at %.1f deg", m.position_deg);
+      if (!m.side.empty()) std::printf(", pivot at %s", m.side.c_str());
+      std::printf(" (%.4f, %.4f)\n", m.x, m.y);
+    }
+    bool sliding = false;
+    for (const MechanismJoint& m : res.mechanism) sliding |= m.kind == "sliding";
+    if (sliding)
+      std::printf(
+          "            the mechanism slides: with associative friction lambda_la is an\n"
+          "            upper bound on the Coulomb (non-associative) collapse load\n");
+  } else if (res.status == "unbounded") {
+    std::printf("lambda_la   unbounded: no horizontal load factor collapses the model\n");
+  } else {
+    std::printf("lambda_la   none: %s (no admissible equilibrium at any lambda)\n",
+                res.status.c_str());
+  }
+
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!common.json_path.empty()) {
+    nlohmann::json j = {{"status", res.status},
+                        {"admissible", res.admissible},
+                        {"gravity_only", opts.gravity_only},
+                        {"friction", mu},
+                        {"free_blocks", res.free_blocks},
+                        {"interfaces", res.interfaces.size()},
+                        {"rows", res.rows},
+                        {"columns", res.columns},
+                        {"iterations", res.iterations},
+                        {"exact", res.exact},
+                        {"lp_wall_s", res.wall_s},
+                        {"model_wall_s", model_s},
+                        {"wall_s", wall_s}};
+    if (!opts.gravity_only) {
+      j["lambda_la"] = number_or_null(res.lambda_la);
+      j["mechanism"] = mechanism_json(res);
+    }
+    write_json(j, common.json_path);
+  }
+  if (!opts.mechanism_out.empty()) {
+    nlohmann::json geo = model_geometry_json(model);
+    nlohmann::json vel = nlohmann::json::array();
+    for (const BlockVelocity& v : res.velocities) vel.push_back({v.ux, v.uy, v.omega});
+    geo["limit"] = {{"status", res.status},
+                    {"gravity_only", opts.gravity_only},
+                    {"lambda_la", number_or_null(res.lambda_la)},
+                    {"friction", mu},
+                    {"mechanism", mechanism_json(res)},
+                    {"interfaces", interfaces_json(res)},
+                    {"block_velocities", vel}};
+    write_json(geo, opts.mechanism_out);
+  }
+  return 0;
+}
+
+}  // namespace voussoir

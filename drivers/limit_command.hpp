@@ -1,0 +1,19 @@
+#pragma once
+// `voussoir limit DECK`: rigid-block limit analysis of the deck's model (limit/).
+
+#include <string>
+
+#include "drivers/commands.hpp"
+#include "io/config.hpp"
+
+namespace voussoir {
+
+struct LimitCommandOptions {
+  bool gravity_only = false;  // --gravity-only: admissibility under self-weight alone
+  std::string mechanism_out;  // --mechanism-out FILE: geometry + mechanism JSON (scripts/draw)
+};
+
+int command_limit(const Config& config, const CommonOptions& common,
+                  const LimitCommandOptions& opts);
+
+}  // namespace voussoir

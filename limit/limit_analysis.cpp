@@ -1,0 +1,301 @@
+// Rigid-block limit analysis as a linear programme (Livesley 1978; Gilbert, Casapulla, Ahmed
+// 2006), solved with GLPK.
+//
+// Unknowns. Each interface k (between blocks a and b, ends p_a and p_b, unit normal n from a
+// into b, tangent t = (p_b - p_a) / |p_b - p_a|) carries at each end e a force on block b
+//   F_e = N_e n + S_e t,   N_e >= 0 (no tension),   |S_e| <= mu N_e (Coulomb),
+// and -F_e on block a. The friction cone of one end has two edges, so it is written exactly
+// as F_e = f+ (n + mu t) + f- (n - mu t) with f+, f- >= 0 (N = f+ + f-, S = mu (f+ - f-)): the
+// LP then has only bounds on its columns and one equality row per equilibrium equation. With
+// mu = 0 the two edges coincide and only f+ is kept. Plus the load factor lambda (free).
+//
+// Equilibrium of each free block i (weight W_i = rho A_i out_of_plane g at the centroid c_i,
+// horizontal load lambda W_i at c_i, moments about a reference point O):
+//   sum F_x + lambda W_i          = 0
+//   sum F_y                       = W_i
+//   sum (r x F) - lambda W_i r_cy = W_i r_cx,        r = p - O, r_c = c_i - O.
+// Fixed blocks have no equations. Objective: maximise lambda (gravity_only: lambda fixed at 0,
+// a feasibility problem). Scaling: lengths in units of the free blocks' bounding-box diagonal
+// L about its centre O, forces in units of the mean free-block weight, so the coefficients are
+// O(1) for any model size; lambda does not depend on either choice (or on g, rho).
+//
+// The dual is the virtual-work (kinematic) problem: the row multipliers of block i are its
+// virtual velocity (u_x, u_y, omega) (velocity of the point r: u + omega e_z x r), the dual
+// row of the lambda column normalises the power of the horizontal load to 1, and the dual
+// constraint of each cone edge d = n +- mu t reads  d . dv_e >= 0, dv_e = v_b(p_e) - v_a(p_e),
+// i.e. dv.n >= mu |dv.t|: opening without interpenetration and associative (dilatant) sliding.
+// Hence lambda_la is exact for mu large enough that no joint slides, and an upper bound on the
+// non-associative (real Coulomb) value where sliding governs (Drucker 1954).
+//
+// Mechanism. At the optimum GLPK gives the row duals (GLPK: d_j = c_j - sum_i a_ij pi_i, so pi
+// is the velocity field with load power +1; the sign is checked anyway). An interface end
+// whose relative velocity has a normal component opens; an interface whose ends have relative
+// velocity is in the mechanism: sliding if its tangential rate is non-zero, else a hinge at
+// the end that stays in contact (the smaller opening), "separation" if both ends open.
+//
+// Solver: glp_simplex (dual then primal phases, presolve off so that duals and an infeasible
+// status are always available), then glp_exact from the optimal basis: the rational re-solve
+// confirms the basis for the floating data (a few pivots at most), and makes the feasibility
+// verdict of the gravity-only problem free of tolerance effects near the critical thickness.
+
+#include "limit/limit_analysis.hpp"
+
+#include <glpk.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace voussoir {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct GlpDeleter {
+  void operator()(glp_prob* p) const { glp_delete_prob(p); }
+};
+
+// One LP column: a cone edge at one end of one interface.
+struct EdgeColumn {
+  Index interface;
+  int end;      // 0: end a, 1: end b
+  double sign;  // +1: n + mu t, -1: n - mu t
+};
+
+}  // namespace
+
+LimitResult limit_analysis(const Model& model, double mu, double gravity, bool gravity_only) {
+  return limit_analysis(model, mu, gravity, gravity_only, LimitOptions{});
+}
+
+LimitResult limit_analysis(const Model& model, double mu, double gravity, bool gravity_only,
+                           const LimitOptions& options) {
+  if (!(mu >= 0.0) || !std::isfinite(mu))
+    throw std::invalid_argument("limit_analysis: friction must be finite and >= 0");
+  if (!(gravity > 0.0) || !std::isfinite(gravity))
+    throw std::invalid_argument("limit_analysis: gravity must be > 0");
+  const auto t0 = std::chrono::steady_clock::now();
+
+  LimitResult res;
+  res.gravity_only = gravity_only;
+  res.lambda_la = kNaN;
+
+  // Blocks: area and centroid of the outline; row index of each free block.
+  const std::size_t nb = model.blocks.size();
+  std::vector<double> area(nb, 0.0);
+  std::vector<Vec2> centroid(nb);
+  std::vector<int> first_row(nb, -1);  // 1-based GLPK row of the block's x equation
+  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, free_area_sum = 0.0;
+  for (std::size_t i = 0; i < nb; ++i) {
+    const Block& b = model.blocks[i];
+    area[i] = polygon_centroid(b.polygon, &centroid[i]);
+    if (b.fixed) continue;
+    first_row[i] = 1 + 3 * res.free_blocks++;
+    free_area_sum += area[i];
+    for (const Vec2& p : b.polygon) {
+      x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
+      y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+    }
+  }
+  if (res.free_blocks == 0) throw std::invalid_argument("limit_analysis: no free block");
+  const Vec2 origin{0.5 * (x0 + x1), 0.5 * (y0 + y1)};
+  const double length = std::max(std::hypot(x1 - x0, y1 - y0), 1e-300);
+  const double area_ref = free_area_sum / res.free_blocks;
+  // Newtons per LP force unit (per out_of_plane thickness as the model has it).
+  const double newton = model.material.density * model.out_of_plane * gravity * area_ref;
+  auto scaled = [&](Vec2 p) { return Vec2{(p.x - origin.x) / length, (p.y - origin.y) / length}; };
+
+  // Interfaces that touch a free block.
+  for (const Interface& f : find_interfaces(model, options.interface_tol))
+    if (!model.blocks[f.block_a].fixed || !model.blocks[f.block_b].fixed)
+      res.interfaces.push_back(f);
+  const Index ni = static_cast<Index>(res.interfaces.size());
+
+  // Columns: 1 = lambda, then the cone edges.
+  std::vector<EdgeColumn> cols;
+  cols.reserve(4 * ni);
+  for (Index k = 0; k < ni; ++k)
+    for (int end = 0; end < 2; ++end) {
+      cols.push_back({k, end, 1.0});
+      if (mu > 0.0) cols.push_back({k, end, -1.0});
+    }
+  res.rows = 3 * res.free_blocks;
+  res.columns = 1 + static_cast<int>(cols.size());
+
+  std::unique_ptr<glp_prob, GlpDeleter> lp(glp_create_prob());
+  glp_prob* P = lp.get();
+  glp_set_obj_dir(P, GLP_MAX);
+  glp_add_rows(P, res.rows);
+  glp_add_cols(P, res.columns);
+  std::vector<int> ia{0}, ja{0};
+  std::vector<double> ar{0.0};
+  ia.reserve(1 + 6 * cols.size() + 2 * res.free_blocks);
+  ja.reserve(ia.capacity());
+  ar.reserve(ia.capacity());
+  auto put = [&](int row, int col, double v) {
+    if (v == 0.0) return;
+    ia.push_back(row), ja.push_back(col), ar.push_back(v);
+  };
+
+  // Rows (right-hand sides: gravity) and the lambda column.
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (first_row[i] < 0) continue;
+    const double w = area[i] / area_ref;
+    const Vec2 rc = scaled(centroid[i]);
+    const int r = first_row[i];
+    glp_set_row_bnds(P, r, GLP_FX, 0.0, 0.0);
+    glp_set_row_bnds(P, r + 1, GLP_FX, w, w);
+    glp_set_row_bnds(P, r + 2, GLP_FX, w * rc.x, w * rc.x);
+    put(r, 1, w);
+    put(r + 2, 1, -w * rc.y);
+  }
+  if (gravity_only)
+    glp_set_col_bnds(P, 1, GLP_FX, 0.0, 0.0);
+  else
+    glp_set_col_bnds(P, 1, GLP_FR, 0.0, 0.0);
+  glp_set_obj_coef(P, 1, 1.0);
+
+  // Cone-edge columns.
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    const int col = 2 + static_cast<int>(c);
+    const Interface& f = res.interfaces[cols[c].interface];
+    const double len = f.length();
+    const Vec2 t{(f.b.x - f.a.x) / len, (f.b.y - f.a.y) / len};
+    const Vec2 d{f.normal.x + cols[c].sign * mu * t.x, f.normal.y + cols[c].sign * mu * t.y};
+    const Vec2 r = scaled(cols[c].end == 0 ? f.a : f.b);
+    const double m = r.x * d.y - r.y * d.x;
+    glp_set_col_bnds(P, col, GLP_LO, 0.0, 0.0);
+    if (const int rb = first_row[f.block_b]; rb > 0) {
+      put(rb, col, d.x), put(rb + 1, col, d.y), put(rb + 2, col, m);
+    }
+    if (const int ra = first_row[f.block_a]; ra > 0) {
+      put(ra, col, -d.x), put(ra + 1, col, -d.y), put(ra + 2, col, -m);
+    }
+  }
+  glp_load_matrix(P, static_cast<int>(ia.size()) - 1, ia.data(), ja.data(), ar.data());
+
+  // Solve.
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.presolve = GLP_OFF;
+  parm.meth = GLP_DUALP;
+  glp_scale_prob(P, GLP_SF_AUTO);
+  glp_adv_basis(P, 0);
+  int rc = glp_simplex(P, &parm);
+  if (rc != 0) {
+    // Retry from the standard basis with the primal simplex before giving up.
+    glp_std_basis(P);
+    parm.meth = GLP_PRIMAL;
+    rc = glp_simplex(P, &parm);
+  }
+  if (rc == 0 && options.exact) res.exact = glp_exact(P, &parm) == 0;
+  res.iterations = glp_get_it_cnt(P);
+  const int status = rc == 0 ? glp_get_status(P) : GLP_UNDEF;
+
+  const bool feasible = status == GLP_OPT || status == GLP_UNBND;
+  if (status == GLP_OPT)
+    res.status = "optimal";
+  else if (status == GLP_NOFEAS)
+    res.status = "infeasible";
+  else if (status == GLP_UNBND)
+    res.status = "unbounded";
+  else
+    res.status = "error";
+  if (gravity_only) {
+    res.admissible = status == GLP_OPT;
+  } else if (status == GLP_OPT) {
+    res.lambda_la = glp_get_col_prim(P, 1);
+    res.admissible = res.lambda_la >= 0.0;
+  } else {
+    res.admissible = status == GLP_UNBND;
+  }
+
+  // Forces of the equilibrium found [N].
+  if (feasible) {
+    res.forces.assign(ni, InterfaceForces{});
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      const double v = glp_get_col_prim(P, 2 + static_cast<int>(c)) * newton;
+      InterfaceForces& F = res.forces[cols[c].interface];
+      (cols[c].end == 0 ? F.normal_a : F.normal_b) += v;
+      (cols[c].end == 0 ? F.shear_a : F.shear_b) += cols[c].sign * mu * v;
+    }
+  }
+
+  // Mechanism from the row duals (full problem at its optimum only).
+  if (!gravity_only && status == GLP_OPT) {
+    std::vector<double> ux(nb, 0.0), uy(nb, 0.0), om(nb, 0.0);  // LP units, about O
+    double power = 0.0;
+    for (std::size_t i = 0; i < nb; ++i) {
+      if (first_row[i] < 0) continue;
+      ux[i] = glp_get_row_dual(P, first_row[i]);
+      uy[i] = glp_get_row_dual(P, first_row[i] + 1);
+      om[i] = glp_get_row_dual(P, first_row[i] + 2);
+      power += area[i] / area_ref * (ux[i] - om[i] * scaled(centroid[i]).y);
+    }
+    const double sign = power < 0.0 ? -1.0 : 1.0;
+    auto velocity = [&](Index i, Vec2 p) {
+      const Vec2 r = scaled(p);
+      return Vec2{sign * (ux[i] - om[i] * r.y), sign * (uy[i] + om[i] * r.x)};
+    };
+    // Relative velocities (b w.r.t. a) at both ends of every interface.
+    std::vector<Vec2> dv(2 * ni);
+    double vmax = 0.0;
+    for (Index k = 0; k < ni; ++k) {
+      const Interface& f = res.interfaces[k];
+      for (int end = 0; end < 2; ++end) {
+        const Vec2 p = end == 0 ? f.a : f.b;
+        const Vec2 vb = velocity(f.block_b, p), va = velocity(f.block_a, p);
+        dv[2 * k + end] = {vb.x - va.x, vb.y - va.y};
+        vmax = std::max(vmax, std::hypot(dv[2 * k + end].x, dv[2 * k + end].y));
+      }
+    }
+    const double scale = vmax > 0.0 ? 1.0 / vmax : 0.0;
+    res.velocities.assign(nb, BlockVelocity{});
+    for (std::size_t i = 0; i < nb; ++i) {
+      if (first_row[i] < 0) continue;
+      const Vec2 vc = velocity(static_cast<Index>(i), centroid[i]);
+      res.velocities[i] = {vc.x * scale, vc.y * scale, sign * om[i] / length * scale};
+    }
+    const double tol = options.motion_tol;
+    for (Index k = 0; k < ni && vmax > 0.0; ++k) {
+      const Interface& f = res.interfaces[k];
+      const double len = f.length();
+      const Vec2 t{(f.b.x - f.a.x) / len, (f.b.y - f.a.y) / len};
+      const Vec2 da{dv[2 * k].x * scale, dv[2 * k].y * scale};
+      const Vec2 db{dv[2 * k + 1].x * scale, dv[2 * k + 1].y * scale};
+      MechanismJoint m;
+      m.interface = k;
+      m.joint = f.joint;
+      m.block_a = f.block_a;
+      m.block_b = f.block_b;
+      m.position_deg = f.position_deg;
+      m.opening_a = da.x * f.normal.x + da.y * f.normal.y;
+      m.opening_b = db.x * f.normal.x + db.y * f.normal.y;
+      // Rigid motion: the tangential rate is the same at both ends (up to rounding).
+      m.slip = 0.5 * std::abs(da.x * t.x + da.y * t.y + db.x * t.x + db.y * t.y);
+      if (std::max({std::abs(m.opening_a), std::abs(m.opening_b), m.slip}) <= tol) continue;
+      if (m.slip > tol) {
+        m.kind = "sliding";
+        m.x = 0.5 * (f.a.x + f.b.x);
+        m.y = 0.5 * (f.a.y + f.b.y);
+      } else {
+        const bool pivot_a = m.opening_a <= m.opening_b;
+        m.kind = std::min(m.opening_a, m.opening_b) <= tol ? "hinge" : "separation";
+        m.side = pivot_a ? "intrados" : "extrados";
+        m.x = pivot_a ? f.a.x : f.b.x;
+        m.y = pivot_a ? f.a.y : f.b.y;
+      }
+      res.mechanism.push_back(m);
+    }
+  }
+
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+}  // namespace voussoir
