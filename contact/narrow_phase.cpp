@@ -1,24 +1,21 @@
 #include "contact/narrow_phase.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace voussoir {
 
 namespace {
 
-// A triangle clipped by up to 5 lines has at most 8 vertices; 12 leaves room.
-constexpr int kMaxPoly = 12;
+// A triangle clipped by 3 lines has at most 6 vertices; 8 leaves room.
+constexpr int kMaxPoly = 8;
 
+// Convex polygon, counter-clockwise. on_c[k] = 1 when the edge from vertex k to k+1 lies on an
+// edge of c (made by clipping), 0 when it lies on an edge of t.
 struct Poly {
   int n = 0;
   double x[kMaxPoly], y[kMaxPoly];
-};
-
-// A polygon whose vertices carry the barycentric coordinates l[m] of one triangle (affine
-// functions, so intersection points interpolate them exactly up to round-off).
-struct BaryPoly {
-  int n = 0;
-  double x[kMaxPoly], y[kMaxPoly], l[3][kMaxPoly];
+  unsigned char on_c[kMaxPoly];
 };
 
 // Affine function a + b x + c y.
@@ -58,54 +55,31 @@ inline Bary barycentric(const Edges& t) {
   return b;
 }
 
-// Keeps the part of convex `in` where f >= 0 (Sutherland-Hodgman, one line).
+// Keeps the part of convex `in` where f >= 0 (Sutherland-Hodgman, one line of c), keeping
+// track of which triangle each edge lies on.
 inline void clip(const Poly& in, const Affine& f, Poly& out) {
   out.n = 0;
-  if (in.n == 0) return;
-  double px = in.x[in.n - 1], py = in.y[in.n - 1];
-  double fp = f(px, py);
-  for (int k = 0; k < in.n; ++k) {
-    const double qx = in.x[k], qy = in.y[k], fq = f(qx, qy);
-    if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
-      const double s = fp / (fp - fq);
-      out.x[out.n] = px + s * (qx - px);
-      out.y[out.n] = py + s * (qy - py);
-      ++out.n;
-    }
-    if (fq >= 0.0) {
-      out.x[out.n] = qx;
-      out.y[out.n] = qy;
-      ++out.n;
-    }
-    px = qx;
-    py = qy;
-    fp = fq;
-  }
-}
-
-// Keeps the part of convex `in` where l[b] - l[a] >= 0, i.e. lambda_a <= lambda_b.
-inline void clip_le(const BaryPoly& in, int a, int b, BaryPoly& out) {
-  out.n = 0;
-  if (in.n == 0) return;
-  int p = in.n - 1;
-  double fp = in.l[b][p] - in.l[a][p];
-  for (int q = 0; q < in.n; ++q) {
-    const double fq = in.l[b][q] - in.l[a][q];
+  double fv[kMaxPoly];
+  for (int k = 0; k < in.n; ++k) fv[k] = f(in.x[k], in.y[k]);
+  for (int q = 0, p = in.n - 1; q < in.n; p = q++) {
+    const double fp = fv[p], fq = fv[q];
     if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
       const double s = fp / (fp - fq);
       out.x[out.n] = in.x[p] + s * (in.x[q] - in.x[p]);
       out.y[out.n] = in.y[p] + s * (in.y[q] - in.y[p]);
-      for (int m = 0; m < 3; ++m) out.l[m][out.n] = in.l[m][p] + s * (in.l[m][q] - in.l[m][p]);
+      // Leaving: the next edge runs along the clip line; entering: along the edge p -> q.
+      out.on_c[out.n] = fq < 0.0 ? 1 : in.on_c[p];
       ++out.n;
     }
     if (fq >= 0.0) {
       out.x[out.n] = in.x[q];
       out.y[out.n] = in.y[q];
-      for (int m = 0; m < 3; ++m) out.l[m][out.n] = in.l[m][q];
+      // Its outgoing edge is part of the input edge q -> r, unless q lies on the line and r
+      // is outside: then no intersection follows and the edge runs along the clip line.
+      const int r = q + 1 < in.n ? q + 1 : 0;
+      out.on_c[out.n] = (fq == 0.0 && fv[r] < 0.0) ? 1 : in.on_c[q];
       ++out.n;
     }
-    p = q;
-    fp = fq;
   }
 }
 
@@ -114,85 +88,115 @@ struct Moments {
   double area = 0.0, sx = 0.0, sy = 0.0;
 };
 
-template <class P>
-inline Moments moments(const P& p) {
+inline Moments moments(const Poly& p) {
   Moments m;
   if (p.n < 3) return m;
+  // Fan from the first vertex (no cancellation for thin polygons), shifted back.
+  const double x0 = p.x[0], y0 = p.y[0];
   double a2 = 0.0, sx6 = 0.0, sy6 = 0.0;
-  for (int k = 0, j = p.n - 1; k < p.n; j = k++) {
-    const double cr = p.x[j] * p.y[k] - p.x[k] * p.y[j];
+  for (int k = 2; k < p.n; ++k) {
+    const double ux = p.x[k - 1] - x0, uy = p.y[k - 1] - y0;
+    const double vx = p.x[k] - x0, vy = p.y[k] - y0;
+    const double cr = ux * vy - uy * vx;
     a2 += cr;
-    sx6 += (p.x[j] + p.x[k]) * cr;
-    sy6 += (p.y[j] + p.y[k]) * cr;
+    sx6 += (ux + vx) * cr;
+    sy6 += (uy + vy) * cr;
   }
   m.area = 0.5 * a2;
-  m.sx = sx6 * (1.0 / 6.0);
-  m.sy = sy6 * (1.0 / 6.0);
+  m.sx = m.area * x0 + sx6 * (1.0 / 6.0);
+  m.sy = m.area * y0 + sy6 * (1.0 / 6.0);
   return m;
 }
 
-// What one triangle's potential field does over the overlap: G = sum_m g_m (A, Sx, Sy)_m
-// (row 0: x component of g, row 1: y) and Phi = int phi dA.
+// What one triangle's potential field does over the overlap: G = int_P grad phi (x) (1, x, y)
+// dA (row 0: x component of grad phi, row 1: y) and Phi = int_P phi dA.
 struct Field {
   double g[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
   double phi = 0.0;
 };
 
-inline void add_region(const Bary& T, int m, const Moments& mo, Field& f) {
-  const Affine& l = T.lam[m];
-  const double gx = 3.0 * l.b, gy = 3.0 * l.c;
-  f.g[0][0] += gx * mo.area;
-  f.g[0][1] += gx * mo.sx;
-  f.g[0][2] += gx * mo.sy;
-  f.g[1][0] += gy * mo.area;
-  f.g[1][1] += gy * mo.sx;
-  f.g[1][2] += gy * mo.sy;
-  f.phi += 3.0 * (l.a * mo.area + l.b * mo.sx + l.c * mo.sy);
+// Along a segment a -> b (parameter s in [0, 1]) phi = 3 min_m (alpha_m + beta_m s), the lower
+// envelope of three lines (concave, at most three pieces). Adds the exact integrals
+// int phi ds, int phi x ds, int phi y ds over [0, 1] to i0, ix, iy.
+inline void integrate_phi(const double* alpha, const double* beta, double ax, double ay, double dx,
+                          double dy, double& i0, double& ix, double& iy) {
+  auto piece = [&](int m, double s0, double s1) {
+    if (!(s1 > s0)) return;
+    const double p0 = 3.0 * (alpha[m] + beta[m] * s0), p1 = 3.0 * (alpha[m] + beta[m] * s1);
+    const double x0 = ax + dx * s0, x1 = ax + dx * s1, y0 = ay + dy * s0, y1 = ay + dy * s1;
+    const double w = s1 - s0;
+    // int_0^1 (p0 + (p1 - p0) u)(x0 + (x1 - x0) u) du = (2 p0 x0 + p0 x1 + p1 x0 + 2 p1 x1) / 6
+    i0 += 0.5 * w * (p0 + p1);
+    ix += w * (1.0 / 6.0) * (p0 * (2.0 * x0 + x1) + p1 * (x0 + 2.0 * x1));
+    iy += w * (1.0 / 6.0) * (p0 * (2.0 * y0 + y1) + p1 * (y0 + 2.0 * y1));
+  };
+  auto argmin = [](double u, double v, double w) {
+    return u <= v ? (u <= w ? 0 : 2) : (v <= w ? 1 : 2);
+  };
+  const int ma = argmin(alpha[0], alpha[1], alpha[2]);
+  const int mb = argmin(alpha[0] + beta[0], alpha[1] + beta[1], alpha[2] + beta[2]);
+  auto cross_at = [&](int i, int j) {  // s where lines i and j meet, clamped to [0, 1]
+    const double den = beta[j] - beta[i];
+    const double s = den != 0.0 ? (alpha[i] - alpha[j]) / den : 0.0;
+    return std::min(1.0, std::max(0.0, s));
+  };
+  if (ma == mb) {
+    piece(ma, 0.0, 1.0);
+    return;
+  }
+  const int mc = 3 - ma - mb;
+  const double s = cross_at(ma, mb);
+  if (alpha[mc] + beta[mc] * s >= alpha[ma] + beta[ma] * s) {
+    piece(ma, 0.0, s);
+    piece(mb, s, 1.0);
+  } else {
+    const double s1 = cross_at(ma, mc), s2 = std::max(s1, cross_at(mc, mb));
+    piece(ma, 0.0, s1);
+    piece(mc, s1, s2);
+    piece(mb, s2, 1.0);
+  }
 }
 
-inline int argmin3(double a, double b, double c) {
-  return a <= b ? (a <= c ? 0 : 2) : (b <= c ? 1 : 2);
-}
-
-// Region m of P (where lambda_m is the smallest coordinate) for m = 0, 1, 2. The region that
-// holds P's centroid (usually the large one) is P minus the other two, so only two regions are
-// clipped (two lines each).
-inline Field field_over(const Bary& T, const Poly& P, const Moments& mp) {
+// Field of triangle T (barycentric lam, centroid (gx, gy)) over P, by boundary integrals.
+// phi_T vanishes on T's edges, so only the edges of P lying on the other triangle count
+// (on_c == other_is_c). With n ds = (dy, -dx) ds_param on a counter-clockwise polygon:
+//     int_P grad phi dA     = sum (dy, -dx) I0,
+//     int_P x grad phi dA   = sum (dy, -dx) Ix - (Phi, 0),   (integration by parts)
+//     int_P y grad phi dA   = sum (dy, -dx) Iy - (0, Phi),
+//     Phi = int_P phi dA    = (sum (dy, -dx) . (Ix - gx I0, Iy - gy I0) + A_P) / 3,
+// the last because div(phi (x - G)) = grad phi . (x - G) + 2 phi = 3 phi - 1 on every
+// sub-triangle (phi = 3 lambda_m is affine there and equals 1 at G), and phi (x - G) is
+// continuous across the sub-triangle lines.
+inline Field field_over(const Bary& T, double gx, double gy, const Poly& P, const Moments& mp,
+                        unsigned char other_is_c) {
   Field f;
-  BaryPoly a;
-  a.n = P.n;
-  int m0 = -1;
-  bool same = true;
-  for (int k = 0; k < P.n; ++k) {
-    const double x = P.x[k], y = P.y[k];
-    a.x[k] = x;
-    a.y[k] = y;
-    for (int m = 0; m < 3; ++m) a.l[m][k] = T.lam[m](x, y);
-    const int m = argmin3(a.l[0][k], a.l[1][k], a.l[2][k]);
-    if (m0 < 0) m0 = m;
-    same = same && m == m0;
+  double j0x = 0.0, j0y = 0.0, jxx = 0.0, jxy = 0.0, jyx = 0.0, jyy = 0.0, k = 0.0;
+  for (int q = 0, r = 1; q < P.n; ++q, r = (r + 1 == P.n ? 0 : r + 1)) {
+    if (P.on_c[q] != other_is_c) continue;
+    const double ax = P.x[q], ay = P.y[q], dx = P.x[r] - ax, dy = P.y[r] - ay;
+    double alpha[3], beta[3];
+    for (int m = 0; m < 3; ++m) {
+      alpha[m] = T.lam[m](ax, ay);
+      beta[m] = T.lam[m].b * dx + T.lam[m].c * dy;
+    }
+    double i0 = 0.0, ix = 0.0, iy = 0.0;
+    integrate_phi(alpha, beta, ax, ay, dx, dy, i0, ix, iy);
+    // Outward normal times length: (dy, -dx).
+    j0x += dy * i0;
+    j0y -= dx * i0;
+    jxx += dy * ix;
+    jxy -= dx * ix;
+    jyx += dy * iy;
+    jyy -= dx * iy;
+    k += dy * (ix - gx * i0) - dx * (iy - gy * i0);
   }
-  // Fast path: every vertex in the same sub-triangle (a convex region), so all of P is.
-  if (same) {
-    add_region(T, m0, mp, f);
-    return f;
-  }
-  const double cx = mp.sx / mp.area, cy = mp.sy / mp.area;
-  const int big = argmin3(T.lam[0](cx, cy), T.lam[1](cx, cy), T.lam[2](cx, cy));
-  Moments rest = mp;
-  BaryPoly tmp, region;
-  for (int m = 0; m < 3; ++m) {
-    if (m == big) continue;
-    clip_le(a, m, (m + 1) % 3, tmp);
-    clip_le(tmp, m, (m + 2) % 3, region);
-    const Moments mo = moments(region);
-    if (!(mo.area > 0.0)) continue;
-    add_region(T, m, mo, f);
-    rest.area -= mo.area;
-    rest.sx -= mo.sx;
-    rest.sy -= mo.sy;
-  }
-  if (rest.area > 0.0) add_region(T, big, rest, f);
+  f.phi = (k + mp.area) * (1.0 / 3.0);
+  f.g[0][0] = j0x;
+  f.g[1][0] = j0y;
+  f.g[0][1] = jxx - f.phi;
+  f.g[1][1] = jxy;
+  f.g[0][2] = jyx;
+  f.g[1][2] = jyy - f.phi;
   return f;
 }
 
@@ -219,6 +223,7 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   for (int k = 0; k < 3; ++k) {
     p0.x[k] = tx[k];
     p0.y[k] = ty[k];
+    p0.on_c[k] = 0;
   }
   clip(p0, ec.e[0], p1);
   if (p1.n < 3) return out;
@@ -231,7 +236,10 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   if (!(mp.area > 0.0)) return out;
 
   const Bary bc = barycentric(ec), bt = barycentric(et);
-  const Field fc = field_over(bc, P, mp), ft = field_over(bt, P, mp);
+  const Field fc =
+      field_over(bc, (cx[0] + cx[1] + cx[2]) / 3.0, (cy[0] + cy[1] + cy[2]) / 3.0, P, mp, 0);
+  const Field ft =
+      field_over(bt, (tx[0] + tx[1] + tx[2]) / 3.0, (ty[0] + ty[1] + ty[2]) / 3.0, P, mp, 1);
 
   // Nodal forces: f_i(c) = Ep [(G_c - G_t) l_i^c - Phi_t grad N_i^c], and symmetrically.
   double d[2][3];

@@ -34,9 +34,14 @@
 // the end that stays in contact (the smaller opening), "separation" if both ends open.
 //
 // Solver: glp_simplex (dual then primal phases, presolve off so that duals and an infeasible
-// status are always available), then glp_exact from the optimal basis: the rational re-solve
-// confirms the basis for the floating data (a few pivots at most), and makes the feasibility
-// verdict of the gravity-only problem free of tolerance effects near the critical thickness.
+// status are always available), then glp_exact from the final basis: the rational re-solve
+// confirms (or corrects, in a few pivots) the basis and the status without the floating
+// simplex's feasibility tolerance (1e-7), which matters for the gravity-only verdict near a
+// critical thickness. glp_exact turns every double into the simplest fraction within 1e-9
+// relative of it, so its verdict is exact for data perturbed at that level, and its values
+// are not used: a last floating-point glp_simplex from its basis (no pivots when the basis
+// is optimal) gives the values of the data as given. Tried and rejected: taking glp_exact's
+// values directly (the single block gave lambda = 0.5 + 2.5e-11 instead of 0.5).
 
 #include "limit/limit_analysis.hpp"
 
@@ -184,6 +189,9 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
   parm.msg_lev = GLP_MSG_OFF;
   parm.presolve = GLP_OFF;
   parm.meth = GLP_DUALP;
+  // GLPK writes to the terminal from glp_scale_prob and glp_adv_basis whatever msg_lev says:
+  // silence it for the solve and restore the caller's setting afterwards.
+  const int term_was = glp_term_out(GLP_OFF);
   glp_scale_prob(P, GLP_SF_AUTO);
   glp_adv_basis(P, 0);
   int rc = glp_simplex(P, &parm);
@@ -193,9 +201,19 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
     parm.meth = GLP_PRIMAL;
     rc = glp_simplex(P, &parm);
   }
-  if (rc == 0 && options.exact) res.exact = glp_exact(P, &parm) == 0;
+  int status = rc == 0 ? glp_get_status(P) : GLP_UNDEF;
+  if (rc == 0 && options.exact && glp_exact(P, &parm) == 0) {
+    // The rational verdict (optimal / infeasible / unbounded) is the one reported. glp_exact
+    // reads each double as the simplest fraction within 1e-9 relative of it (GLPK's set_d_eps),
+    // so its values belong to data perturbed at that level: re-solve in floating point from
+    // its basis (no pivot when the basis is optimal) to report values of the data as given.
+    res.exact = true;
+    status = glp_get_status(P);
+    if (status == GLP_OPT && glp_simplex(P, &parm) == 0 && glp_get_status(P) != GLP_OPT)
+      status = glp_get_status(P);
+  }
+  glp_term_out(term_was);
   res.iterations = glp_get_it_cnt(P);
-  const int status = rc == 0 ? glp_get_status(P) : GLP_UNDEF;
 
   const bool feasible = status == GLP_OPT || status == GLP_UNBND;
   if (status == GLP_OPT)

@@ -75,7 +75,8 @@ struct Scene {
   std::vector<ArcPiece> centreline;
   double centreline_length = 0.0;
   double arch_thickness = 0.0;
-  int through_thickness = 0;          // elements across the arch thickness (arch scenes)
+  int through_thickness = 0;          // cells across the arch thickness (arch scenes)
+  int cells_along = 0;                // cells along each voussoir (arch scenes)
 };
 
 // Builds the scene of the deck's [model] (not yet meshed). Throws DeckError for a geometry

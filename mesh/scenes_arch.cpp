@@ -253,6 +253,7 @@ void add_voussoirs(const Config& config, const HalfCentreline& cl, Scene& scene,
   scene.centreline_length = 2.0 * cl.half_length;
   scene.arch_thickness = t;
   scene.through_thickness = n;
+  scene.cells_along = m;
   scene.element_size = h;
   scene.symmetric = true;
 }

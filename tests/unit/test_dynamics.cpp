@@ -255,9 +255,11 @@ TEST(Dynamics, DampedStableStepFormulaIsSharpForOneMode) {
 TEST(Dynamics, DampingLeavesRigidMotionAlone) {
   // A block translating at (1, 0.5) m/s and spinning at 5 rad/s about its centre, damping on.
   // What may legitimately change K: centrifugal stretching, U/K ~ (omega L / c)^2 ~ 5e-8, and
-  // the chord velocity of the leapfrog, whose D ~ omega^2 dt / 2 dissipates a fraction
-  // ~ 24 h c omega^2 dt^2 T / L^2 ~ 2e-7 over the run. We demand 1e-5, and show that a
-  // deforming velocity field of the same kinetic energy loses most of it.
+  // the chord velocity of the leapfrog, whose D ~ omega^2 dt / 2 ~ 2e-5 /s is an isotropic
+  // rate: its viscous force is radial and does almost no work on the tangential motion (a
+  // bound from the power alone, eta V |D|^2 T / K, is ~4e-8). Measured: 7e-9 change of K and
+  // 4e-9 dissipated. We demand 1e-6, and show that a deforming velocity field of similar
+  // kinetic energy loses most of it.
   const Material mat = stone();
   const double width = 0.4, height = 0.2;
   auto run = [&](bool rigid, double* k0) {
@@ -289,8 +291,8 @@ TEST(Dynamics, DampingLeavesRigidMotionAlone) {
       k0, k1, k1 / k0 - 1.0, sim.ledger.damping_dissipated, sim.ledger.strain, sim.ctx.time,
       5.0 * sim.ctx.time);
   EXPECT_GT(5.0 * sim.ctx.time, 0.5);  // it really turned (more than half a radian)
-  EXPECT_LT(std::abs(k1 - k0), 1e-5 * k0);
-  EXPECT_LT(sim.ledger.damping_dissipated, 1e-5 * k0);
+  EXPECT_LT(std::abs(k1 - k0), 1e-6 * k0);
+  EXPECT_LT(sim.ledger.damping_dissipated, 1e-6 * k0);
 
   double k0_def = 0.0;
   const Simulation def = run(false, &k0_def);

@@ -1,0 +1,159 @@
+#pragma once
+// Base-excitation runs (SPEC.md sections 2 and 4, `voussoir pulse`).
+//
+// A pulse run:
+//   1. settle the structure under gravity (drivers/capacity.hpp settle(); shared by all the
+//      runs of a failure curve);
+//   2. apply the base signal a_g(t) from t = 0 (signal time, counted from the settled state)
+//      as the inertial body force in the frame of the supports:
+//          body_ax = lambda g - a_g(t),  body_ay = -g           (core/base_motion.hpp)
+//      (a non-zero deck load.lambda is ramped on over TrialCriteria::ramp_time before the
+//      signal starts, as in a capacity trial);
+//   3. run on after the signal ends, T = signal duration, and classify.
+//
+// Classification (motions of the free blocks measured from the settled state, by their
+// best-fit rigid motion, drivers/kinematics.hpp; L_ref = square root of the smallest free
+// block area, 0.050 m for scaled_arch):
+//   collapsed ("fall")  as soon as any block centroid has moved more than
+//                       fall_displacement x L_ref, or any block has rotated more than
+//                       fall_rotation, during or after the signal. These are beyond any motion
+//                       a masonry block comes back from: a rocking block of width b and height
+//                       h returns only while its rotation stays below atan(b/h) (0.46 rad at
+//                       b/h = 0.5), and an arch mechanism's point of no return is smaller
+//                       (hinge rotations of a few hundredths of a radian); a displacement of a
+//                       block size means voussoirs falling through.
+//   survived ("rest")   once the signal is over and the largest free-node speed has stayed
+//                       below rest_speed x sqrt(g L_ref) for hold_time: the structure came to
+//                       rest (possibly displaced; the residual motion is reported).
+//   timeout             when neither fired within free_time after the signal: collapsed if the
+//                       motion is still growing (the motion measure max(d / d_fall,
+//                       |rot| / rot_fall) now exceeds by 10% its largest value over the first
+//                       two thirds of the free motion), survived otherwise (rocking or
+//                       creeping about a displaced state with bounded amplitude).
+// Large rocking during the pulse is therefore allowed: nothing is decided from the pulse's
+// peak response alone, only from falling or from what remains after it.
+//
+// Failure curve (`pulse --curve`): for each frequency f, the smallest amplitude A [g] of the
+// deck's signal that collapses the structure, by bisection: bracket from A0 = lambda* (below
+// it a pulse cannot collapse a structure whose quasi-static capacity is lambda*, up to dynamic
+// effects: the windowed sine peaks at about 0.88 A) growing by kBracketGrowth until a collapse
+// (at most kMaxAmplitude g), then bisection until hi - lo <= tolerance x hi; A_c = hi, the
+// smallest amplitude seen to collapse (conservative by at most the tolerance). Rocking
+// structures can respond non-monotonically to amplitude (collapse at A, survive at a larger
+// A); bisection finds one threshold of the bracket, reported with its bracket. Frequencies run
+// in parallel (OpenMP, one frequency per thread, dynamic schedule), each from a copy of one
+// settled state; the result for a frequency does not depend on the thread count.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/base_motion.hpp"
+#include "drivers/capacity.hpp"
+#include "drivers/commands.hpp"
+
+namespace voussoir {
+
+struct PulseCriteria {
+  TrialCriteria settle;             // settling under gravity and the lambda ramp
+  double fall_displacement = 1.0;   // x L_ref
+  double fall_rotation = 1.0;       // [rad]
+  double rest_speed = 1e-3;         // x sqrt(g L_ref); 0.7 mm/s for scaled_arch
+  double hold_time = 0.05;          // [s]
+  double free_time = 1.5;           // [s] after the signal before the timeout decision
+  double sample_time = 1e-3;        // [s] between classification samples
+};
+
+// A named point whose displacement relative to the table is recorded: the node of `block`
+// nearest to the reference position (x0, y0).
+struct ControlPoint {
+  std::string name;
+  Index block = 0;
+  Index node = 0;
+  double x0 = 0.0, y0 = 0.0;  // [m]
+};
+
+// Control points of a model. Arches (blocks with role "voussoir", ordered from the left
+// springing by centroid x): the extrados corners (the extrados ends of the two joints) of the
+// k-th voussoir from each springing, k = min(6, ceil(n/2)), named
+// "left6_springing_side", "left6_crown_side", "right6_springing_side", "right6_crown_side"
+// (for k = 6). Other scenes: the highest node of every free block (at most 8), "block<b>_top".
+std::vector<ControlPoint> find_control_points(const Model& model);
+
+// Running summary of one control point [m]; displacements relative to the table, from the
+// settled state.
+struct ControlSummary {
+  ControlPoint point;
+  double max_abs_ux = 0.0, max_abs_uy = 0.0, max_displacement = 0.0;
+  double final_ux = 0.0, final_uy = 0.0;
+};
+
+// What a recorder sees at each recording sample.
+struct PulseSample {
+  double time = 0.0;  // signal time [s] (0 at the start of the signal)
+  double table_acceleration = 0.0, table_velocity = 0.0, table_displacement = 0.0;
+  std::vector<double> control_ux, control_uy;  // per control point [m]
+};
+using PulseRecorder = std::function<void(const Simulation&, const PulseSample&)>;
+
+struct PulseResult {
+  double amplitude_g = 0.0;         // [g] (signal peak scale)
+  double frequency = 0.0;           // [Hz]
+  double signal_duration = 0.0;     // T [s]
+  bool collapsed = false;
+  std::string reason;               // "fall", "rest", "timeout"
+  double decided_at = 0.0;          // signal time of the decision [s]
+  long long steps = 0;
+  double wall_s = 0.0;
+  double max_kinetic_energy = 0.0;  // [J]
+  double energy_balance_error = 0.0;      // at the end
+  double max_energy_balance_error = 0.0;  // largest over the samples
+  double peak_energy = 0.0;               // ledger max energy [J]
+  double max_displacement = 0.0;    // largest block centroid displacement seen [m]
+  double max_rotation = 0.0;        // [rad]
+  double residual_displacement = 0.0;  // at the end [m]
+  double residual_rotation = 0.0;      // [rad]
+  std::vector<ControlSummary> control;
+  std::vector<Hinge> hinges;        // joints open or slid at the end
+};
+
+// One pulse run from a copy of `settled`. `recorder` (optional) is called every
+// `record_every` seconds of signal time (and at the start and the end).
+PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, double lambda,
+                      const std::vector<ControlPoint>& points, const PulseCriteria& criteria,
+                      const PulseRecorder& recorder = nullptr, double record_every = 1e-3);
+
+struct CurvePoint {
+  double frequency = 0.0;       // [Hz]
+  double amplitude = 0.0;       // [g] smallest collapsing amplitude found (hi)
+  double lo = 0.0, hi = 0.0;    // bracket [g]: survived at lo, collapsed at hi
+  bool bracketed = false;       // false: no collapse up to kMaxAmplitude
+  int trials = 0;
+  double wall_s = 0.0;
+  double max_energy_balance_error = 0.0;  // over the trials
+  std::vector<PulseResult> runs;
+};
+
+constexpr double kBracketGrowth = 1.5;
+constexpr double kMaxAmplitude = 20.0;  // [g]
+
+// The collapse amplitude at one frequency (header comment); `a0` > 0 is the first trial [g].
+CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
+                                   double frequency, double a0, double tolerance,
+                                   const PulseCriteria& criteria, bool quiet);
+
+struct PulseOptions {
+  std::string output;               // -o FILE: HDF5 of the single run
+  std::string series;               // --series FILE.csv: time series of the single run
+  bool curve = false;               // --curve
+  std::vector<double> freqs;        // --freqs F1,F2,... [Hz]
+  std::string csv;                  // --csv FILE (curve; default curve.csv)
+  std::string plot;                 // --plot FILE.png (curve, by scripts/plot_curve)
+  double lambda_star = -1.0;        // --lambda-star X: skip the capacity search (< 0: compute)
+  double tolerance = 0.02;          // --tolerance: relative bracket width on A
+  int points = 2;                   // --points: capacity trials per round
+};
+
+int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts);
+
+}  // namespace voussoir
