@@ -12,6 +12,7 @@
 
 #include "drivers/commands.hpp"
 #include "drivers/limit_command.hpp"
+#include "drivers/pulse.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
 #include "voussoir/config.hpp"
@@ -72,6 +73,25 @@ int main(int argc, char** argv) {
   limit->add_option("--mechanism-out", limit_opts.mechanism_out,
                     "write the block polygons and the mechanism as JSON (scripts/draw)");
 
+  voussoir::PulseOptions pulse_opts;
+  CLI::App* pulse = app.add_subcommand(
+      "pulse", "base-excitation run; --curve: collapse amplitude per frequency (failure curve)");
+  add_common(pulse, deck, common);
+  pulse->add_option("-o,--output", pulse_opts.output, "HDF5 output file (overrides output.file)");
+  pulse->add_option("--series", pulse_opts.series,
+                    "CSV time series of the run (input, energy, control points)");
+  pulse->add_flag("--curve", pulse_opts.curve, "failure curve: bisection on the amplitude");
+  pulse->add_option("--freqs", pulse_opts.freqs, "curve frequencies F1,F2,... [Hz]")
+      ->delimiter(',');
+  pulse->add_option("--csv", pulse_opts.csv, "curve CSV (default curve.csv)");
+  pulse->add_option("--plot", pulse_opts.plot, "curve PNG (scripts/plot_curve)");
+  pulse->add_option("--lambda-star", pulse_opts.lambda_star,
+                    "tilting capacity to draw (skips the capacity search)");
+  pulse->add_option("--tolerance", pulse_opts.tolerance,
+                    "relative bracket width of the amplitude (default 0.02)");
+  pulse->add_option("--points", pulse_opts.points, "capacity trials per round (default 2)")
+      ->check(CLI::Range(1, 64));
+
   voussoir::SweepOptions sweep_opts;
   CLI::App* sweep = app.add_subcommand("sweep", "capacity over a grid of deck values");
   add_common(sweep, deck, common);
@@ -98,6 +118,7 @@ int main(int argc, char** argv) {
     if (run->parsed()) return voussoir::command_run(config, common, run_opts);
     if (capacity->parsed()) return voussoir::command_capacity(config, common, cap_opts);
     if (limit->parsed()) return voussoir::command_limit(config, common, limit_opts);
+    if (pulse->parsed()) return voussoir::command_pulse(config, common, pulse_opts);
   } catch (const voussoir::DeckError& e) {
     std::fprintf(stderr, "voussoir: error: %s\n", e.what());
     return 2;

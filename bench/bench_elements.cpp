@@ -2,7 +2,9 @@
 // forces + body loads + central-difference integration), one thread, in triangle-steps per
 // second. Meshes: a structured rectangle of ~1e3 and ~1e5 triangles (alternating diagonals),
 // E = 40 GPa, nu = 0.2, rho = 2000, gravity on, Munjiza damping factor 1 (or 0: "undamped").
-// Run: build/bench_elements  (figures go to docs/benchmarks.md).
+// Run: build/bench_elements  (figures go to docs/benchmarks.md). The rate counter divides by
+// CPU time (Google Benchmark's default), which is the single-thread figure even when other
+// processes share the machine.
 
 #include <benchmark/benchmark.h>
 

@@ -1,5 +1,11 @@
 // Contact stage: NBS broad phase (lazy), potential penalty narrow phase, Coulomb friction.
 //
+// Threads. With OpenMP and at least kParallelPairs candidates, pairs are evaluated in parallel
+// (each pair owns its friction state), their results stored per pair and added to the nodes
+// serially in pair order, so forces and energies are bit-identical for any thread count
+// (no atomics, no per-thread force arrays). Below that size, or inside an enclosing parallel
+// region (parallel sweeps), one thread does both in the same order.
+//
 // Stable time step contribution (max_omega_squared). Model: a boundary edge k of length L
 // pressed flat into a partner face by a depth d. The overlap is a strip of area L d lying in
 // the sub-triangles next to the two faces, where |grad phi| = 3/h (h: height of each triangle
@@ -23,6 +29,8 @@
 
 #include "contact/contact.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -32,6 +40,21 @@
 #include "contact/narrow_phase.hpp"
 
 namespace voussoir {
+
+namespace {
+
+// Fewer candidate pairs than this are evaluated on one thread (a parallel region costs a few
+// microseconds, about ten pair evaluations).
+constexpr std::size_t kParallelPairs = 128;
+
+// What one pair adds: nodal forces (potential + friction), stored and dissipated energy.
+struct PairResult {
+  Vec2 on_c[3], on_t[3];
+  double energy = 0.0, stored = 0.0, dissipated = 0.0;
+  bool active = false;
+};
+
+}  // namespace
 
 struct ContactSystem::Impl {
   ContactParams params;
@@ -52,6 +75,10 @@ struct ContactSystem::Impl {
   std::int64_t active = 0;
   std::int64_t detections = 0;
 
+  std::vector<PairResult> results;  // per-pair slots of the multi-threaded path
+
+  template <bool kFriction>
+  PairResult evaluate(std::size_t p, const Nodes& n, const Triangles& t, double dt);
   template <bool kFriction>
   void accumulate(Model& model, double dt, EnergyLedger& ledger);
 };
@@ -129,73 +156,102 @@ void ContactSystem::detect(const Model& model) {
 }
 
 template <bool kFriction>
+inline PairResult ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, const Triangles& t,
+                                                double dt) {
+  PairResult r;
+  const double* x = n.x.data();
+  const double* y = n.y.data();
+  const Index a = pairs[p].a, b = pairs[p].b;
+  const Index c[3] = {t.n0[a], t.n1[a], t.n2[a]};
+  const Index d[3] = {t.n0[b], t.n1[b], t.n2[b]};
+  // Quick rejection on the current (uninflated) boxes.
+  const double cxl = std::min({x[c[0]], x[c[1]], x[c[2]]});
+  const double cxh = std::max({x[c[0]], x[c[1]], x[c[2]]});
+  const double dxl = std::min({x[d[0]], x[d[1]], x[d[2]]});
+  const double dxh = std::max({x[d[0]], x[d[1]], x[d[2]]});
+  const double cyl = std::min({y[c[0]], y[c[1]], y[c[2]]});
+  const double cyh = std::max({y[c[0]], y[c[1]], y[c[2]]});
+  const double dyl = std::min({y[d[0]], y[d[1]], y[d[2]]});
+  const double dyh = std::max({y[d[0]], y[d[1]], y[d[2]]});
+  PairForce f;
+  if (cxl < dxh && dxl < cxh && cyl < dyh && dyl < cyh) {
+    f = triangle_pair_force(
+        {Vec2{x[c[0]], y[c[0]]}, Vec2{x[c[1]], y[c[1]]}, Vec2{x[c[2]], y[c[2]]}},
+        {Vec2{x[d[0]], y[d[0]]}, Vec2{x[d[1]], y[d[1]]}, Vec2{x[d[2]], y[d[2]]}},
+        penalty * thickness);
+  }
+  if (!(f.area > 0.0)) {
+    if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
+    return r;
+  }
+  r.active = true;
+  r.energy = f.energy;
+  for (int k = 0; k < 3; ++k) {
+    r.on_c[k] = f.on_c[k];
+    r.on_t[k] = f.on_t[k];
+  }
+  if constexpr (kFriction) {
+    const double* vx = n.vx.data();
+    const double* vy = n.vy.data();
+    const auto& wc = f.bary_c;
+    const auto& wt = f.bary_t;
+    const Vec2 du{dt * (wc[0] * vx[c[0]] + wc[1] * vx[c[1]] + wc[2] * vx[c[2]] - wt[0] * vx[d[0]] -
+                        wt[1] * vx[d[1]] - wt[2] * vx[d[2]]),
+                  dt * (wc[0] * vy[c[0]] + wc[1] * vy[c[1]] + wc[2] * vy[c[2]] - wt[0] * vy[d[0]] -
+                        wt[1] * vy[d[1]] - wt[2] * vy[d[2]])};
+    const FrictionResult fr =
+        coulomb_friction(f.resultant, du, {sx[p], sy[p]}, kt[p], params.friction);
+    sx[p] = fr.slip.x;
+    sy[p] = fr.slip.y;
+    for (int k = 0; k < 3; ++k) {
+      r.on_c[k].x += wc[k] * fr.force.x;
+      r.on_c[k].y += wc[k] * fr.force.y;
+      r.on_t[k].x -= wt[k] * fr.force.x;
+      r.on_t[k].y -= wt[k] * fr.force.y;
+    }
+    r.stored = fr.stored;
+    r.dissipated = fr.dissipated;
+  }
+  return r;
+}
+
+template <bool kFriction>
 void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledger) {
   Nodes& n = model.nodes;
   const Triangles& t = model.tris;
-  const double* x = n.x.data();
-  const double* y = n.y.data();
-  const double* vx = n.vx.data();
-  const double* vy = n.vy.data();
   double* fx = n.fx.data();
   double* fy = n.fy.data();
-  const Index* tn0 = t.n0.data();
-  const Index* tn1 = t.n1.data();
-  const Index* tn2 = t.n2.data();
-  const double ep = penalty * thickness, mu = params.friction;
   double energy = 0.0, stored = 0.0, dissipated = 0.0;
   std::int64_t n_active = 0;
-
-  const std::size_t np = pairs.size();
-  for (std::size_t p = 0; p < np; ++p) {
-    const Index a = pairs[p].a, b = pairs[p].b;
-    const Index c[3] = {tn0[a], tn1[a], tn2[a]};
-    const Index d[3] = {tn0[b], tn1[b], tn2[b]};
-    // Quick rejection on the current (uninflated) boxes.
-    const double cxl = std::min({x[c[0]], x[c[1]], x[c[2]]});
-    const double cxh = std::max({x[c[0]], x[c[1]], x[c[2]]});
-    const double dxl = std::min({x[d[0]], x[d[1]], x[d[2]]});
-    const double dxh = std::max({x[d[0]], x[d[1]], x[d[2]]});
-    const double cyl = std::min({y[c[0]], y[c[1]], y[c[2]]});
-    const double cyh = std::max({y[c[0]], y[c[1]], y[c[2]]});
-    const double dyl = std::min({y[d[0]], y[d[1]], y[d[2]]});
-    const double dyh = std::max({y[d[0]], y[d[1]], y[d[2]]});
-    PairForce f;
-    if (cxl < dxh && dxl < cxh && cyl < dyh && dyl < cyh) {
-      f = triangle_pair_force(
-          {Vec2{x[c[0]], y[c[0]]}, Vec2{x[c[1]], y[c[1]]}, Vec2{x[c[2]], y[c[2]]}},
-          {Vec2{x[d[0]], y[d[0]]}, Vec2{x[d[1]], y[d[1]]}, Vec2{x[d[2]], y[d[2]]}}, ep);
-    }
-    if (!(f.area > 0.0)) {
-      if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
-      continue;
-    }
+  // Adds one pair's result; always called in pair order, so the sums are the same whatever
+  // the number of threads that evaluated the pairs.
+  auto apply = [&](std::size_t p, const PairResult& r) {
+    if (!r.active) return;
     ++n_active;
-    energy += f.energy;
+    energy += r.energy;
+    stored += r.stored;
+    dissipated += r.dissipated;
+    const Index a = pairs[p].a, b = pairs[p].b;
+    const Index c[3] = {t.n0[a], t.n1[a], t.n2[a]};
+    const Index d[3] = {t.n0[b], t.n1[b], t.n2[b]};
     for (int k = 0; k < 3; ++k) {
-      fx[c[k]] += f.on_c[k].x;
-      fy[c[k]] += f.on_c[k].y;
-      fx[d[k]] += f.on_t[k].x;
-      fy[d[k]] += f.on_t[k].y;
+      fx[c[k]] += r.on_c[k].x;
+      fy[c[k]] += r.on_c[k].y;
+      fx[d[k]] += r.on_t[k].x;
+      fy[d[k]] += r.on_t[k].y;
     }
-    if constexpr (kFriction) {
-      const auto& wc = f.bary_c;
-      const auto& wt = f.bary_t;
-      const Vec2 du{dt * (wc[0] * vx[c[0]] + wc[1] * vx[c[1]] + wc[2] * vx[c[2]] -
-                          wt[0] * vx[d[0]] - wt[1] * vx[d[1]] - wt[2] * vx[d[2]]),
-                    dt * (wc[0] * vy[c[0]] + wc[1] * vy[c[1]] + wc[2] * vy[c[2]] -
-                          wt[0] * vy[d[0]] - wt[1] * vy[d[1]] - wt[2] * vy[d[2]])};
-      const FrictionResult r = coulomb_friction(f.resultant, du, {sx[p], sy[p]}, kt[p], mu);
-      sx[p] = r.slip.x;
-      sy[p] = r.slip.y;
-      for (int k = 0; k < 3; ++k) {
-        fx[c[k]] += wc[k] * r.force.x;
-        fy[c[k]] += wc[k] * r.force.y;
-        fx[d[k]] -= wt[k] * r.force.x;
-        fy[d[k]] -= wt[k] * r.force.y;
-      }
-      stored += r.stored;
-      dissipated += r.dissipated;
-    }
+  };
+  const std::size_t np = pairs.size();
+  if (np >= kParallelPairs && omp_get_max_threads() > 1 && !omp_in_parallel()) {
+    // Pairs are independent (each owns its friction state); results go to per-pair slots
+    // and are added serially in pair order: bit-identical to the one-thread path.
+    results.resize(np);
+    const std::int64_t count = static_cast<std::int64_t>(np);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t p = 0; p < count; ++p) results[p] = evaluate<kFriction>(p, n, t, dt);
+    for (std::size_t p = 0; p < np; ++p) apply(p, results[p]);
+  } else {
+    for (std::size_t p = 0; p < np; ++p) apply(p, evaluate<kFriction>(p, n, t, dt));
   }
   active = n_active;
   ledger.contact = energy + stored;

@@ -115,46 +115,46 @@ struct Field {
   double phi = 0.0;
 };
 
-// Along a segment a -> b (parameter s in [0, 1]) phi = 3 min_m (alpha_m + beta_m s), the lower
-// envelope of three lines (concave, at most three pieces). Adds the exact integrals
-// int phi ds, int phi x ds, int phi y ds over [0, 1] to i0, ix, iy.
-inline void integrate_phi(const double* alpha, const double* beta, double ax, double ay, double dx,
-                          double dy, double& i0, double& ix, double& iy) {
+// Along a segment (parameter s in [0, 1]) phi = 3 min_m (alpha_m + beta_m s), the lower
+// envelope of three lines (concave, at most three pieces). Returns the exact integrals
+// i0 = int_0^1 phi ds and i1 = int_0^1 phi s ds (then int phi x ds = ax i0 + dx i1).
+inline void integrate_phi(const double* alpha, const double* beta, double& i0, double& i1) {
+  double j0 = 0.0, j1 = 0.0;
   auto piece = [&](int m, double s0, double s1) {
-    if (!(s1 > s0)) return;
-    const double p0 = 3.0 * (alpha[m] + beta[m] * s0), p1 = 3.0 * (alpha[m] + beta[m] * s1);
-    const double x0 = ax + dx * s0, x1 = ax + dx * s1, y0 = ay + dy * s0, y1 = ay + dy * s1;
     const double w = s1 - s0;
-    // int_0^1 (p0 + (p1 - p0) u)(x0 + (x1 - x0) u) du = (2 p0 x0 + p0 x1 + p1 x0 + 2 p1 x1) / 6
-    i0 += 0.5 * w * (p0 + p1);
-    ix += w * (1.0 / 6.0) * (p0 * (2.0 * x0 + x1) + p1 * (x0 + 2.0 * x1));
-    iy += w * (1.0 / 6.0) * (p0 * (2.0 * y0 + y1) + p1 * (y0 + 2.0 * y1));
+    const double p0 = alpha[m] + beta[m] * s0, p1 = alpha[m] + beta[m] * s1;
+    // int_s0^s1 phi ds and int_s0^s1 phi s ds for linear phi (p0, p1 at the ends), over 3.
+    j0 += w * (p0 + p1);
+    j1 += w * (p0 * (2.0 * s0 + s1) + p1 * (s0 + 2.0 * s1));
   };
   auto argmin = [](double u, double v, double w) {
     return u <= v ? (u <= w ? 0 : 2) : (v <= w ? 1 : 2);
   };
   const int ma = argmin(alpha[0], alpha[1], alpha[2]);
   const int mb = argmin(alpha[0] + beta[0], alpha[1] + beta[1], alpha[2] + beta[2]);
-  auto cross_at = [&](int i, int j) {  // s where lines i and j meet, clamped to [0, 1]
-    const double den = beta[j] - beta[i];
-    const double s = den != 0.0 ? (alpha[i] - alpha[j]) / den : 0.0;
-    return std::min(1.0, std::max(0.0, s));
-  };
   if (ma == mb) {
     piece(ma, 0.0, 1.0);
-    return;
-  }
-  const int mc = 3 - ma - mb;
-  const double s = cross_at(ma, mb);
-  if (alpha[mc] + beta[mc] * s >= alpha[ma] + beta[ma] * s) {
-    piece(ma, 0.0, s);
-    piece(mb, s, 1.0);
   } else {
-    const double s1 = cross_at(ma, mc), s2 = std::max(s1, cross_at(mc, mb));
-    piece(ma, 0.0, s1);
-    piece(mc, s1, s2);
-    piece(mb, s2, 1.0);
+    auto cross_at = [&](int i, int j) {  // s where lines i and j meet, clamped to [0, 1]
+      const double den = beta[j] - beta[i];
+      const double s = den != 0.0 ? (alpha[i] - alpha[j]) / den : 0.0;
+      return std::min(1.0, std::max(0.0, s));
+    };
+    const int mc = 3 - ma - mb;
+    const double s = cross_at(ma, mb);
+    if (alpha[mc] + beta[mc] * s >= alpha[ma] + beta[ma] * s) {
+      piece(ma, 0.0, s);
+      piece(mb, s, 1.0);
+    } else {
+      const double s1 = cross_at(ma, mc), s2 = std::max(s1, cross_at(mc, mb));
+      piece(ma, 0.0, s1);
+      piece(mc, s1, s2);
+      piece(mb, s2, 1.0);
+    }
   }
+  // phi = 3 lambda: trapezoid 1/2 and Simpson-type 1/6 weights times 3.
+  i0 = 1.5 * j0;
+  i1 = 0.5 * j1;
 }
 
 // Field of triangle T (barycentric lam, centroid (gx, gy)) over P, by boundary integrals.
@@ -179,8 +179,9 @@ inline Field field_over(const Bary& T, double gx, double gy, const Poly& P, cons
       alpha[m] = T.lam[m](ax, ay);
       beta[m] = T.lam[m].b * dx + T.lam[m].c * dy;
     }
-    double i0 = 0.0, ix = 0.0, iy = 0.0;
-    integrate_phi(alpha, beta, ax, ay, dx, dy, i0, ix, iy);
+    double i0, i1;
+    integrate_phi(alpha, beta, i0, i1);
+    const double ix = ax * i0 + dx * i1, iy = ay * i0 + dy * i1;
     // Outward normal times length: (dy, -dx).
     j0x += dy * i0;
     j0y -= dx * i0;
@@ -233,7 +234,7 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   const Poly& P = p1;
   if (P.n < 3) return out;
   const Moments mp = moments(P);
-  if (!(mp.area > 0.0)) return out;
+  if (!(mp.area > kMinOverlapFraction * 0.5 * std::min(ec.twice_area, et.twice_area))) return out;
 
   const Bary bc = barycentric(ec), bt = barycentric(et);
   const Field fc =

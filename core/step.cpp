@@ -41,7 +41,9 @@ CstLaw law_of(const StepContext& ctx) {
 }  // namespace
 
 // eta = damping_factor x 2 h sqrt(E rho), h the smallest triangle height of the free blocks
-// (SPEC section 1): the critical viscosity of the shortest element mode in Munjiza's scaling.
+// (SPEC section 1): Munjiza's scaling of critical damping for the shortest element modes (at
+// factor 1 the breathing mode of an equilateral triangle, nu = 0.2, has damping ratio 1.8;
+// the low structural modes are damped in proportion to h / their wavelength).
 void prepare_context(Simulation& sim, double damping_factor) {
   const Material& mat = sim.model.material;
   sim.ctx.lame_lambda = mat.lame_lambda_2d();
@@ -116,7 +118,8 @@ void advance(Simulation& sim) {
   //   body load:  dt/2 (a^n + a^(n-1)) . sum m v^(n-1/2)                     (core/loads.hpp)
   //   damping:    -dt/2 (f_v^n + f_v^(n-1)) . v^(n-1/2)
   //             =  dt/2 (sum V0 J eta D:D + sum V0 P_v^(n-1) : Fdot(v^(n-1/2)))
-  // (the second sum uses the viscous stress kept from the previous step). At the first step
+  // (the second sum uses the viscous stress kept from the previous step; dt is taken constant
+  // from step to step, as the drivers use it). At the first step
   // there is no such increment and the initial state's energy is booked as input instead.
   if (first) {
     ledger.external_work += ledger.stored();

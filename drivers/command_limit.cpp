@@ -75,9 +75,12 @@ int command_limit(const Config& config, const CommonOptions& common,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double mu = config.contact.friction;
   const double g = config.load.gravity;
-  if (!(g > 0.0))
-    throw DeckError(config.deck_path + ": load.gravity = " + std::to_string(g) +
+  if (!(g > 0.0)) {
+    char value[64];
+    std::snprintf(value, sizeof value, "%g", g);
+    throw DeckError(config.deck_path + ": load.gravity = " + value +
                     ": limit analysis needs gravity > 0 (the load is lambda x weight)");
+  }
   if (!common.quiet)
     std::fprintf(stderr, "limit: %zu blocks, model built in %.2f s; solving the LP...\n",
                  model.blocks.size(), model_s);
@@ -91,8 +94,8 @@ int command_limit(const Config& config, const CommonOptions& common,
               res.wall_s);
   if (opts.gravity_only) {
     std::printf("gravity     %s: %s\n", res.admissible ? "admissible" : "NOT admissible",
-                res.admissible ? "an equilibrium with no tension and |S| <= mu N exists"
-                               : "no equilibrium under self-weight without tension");
+                res.admissible ? "an equilibrium with N >= 0 and |S| <= mu N exists"
+                               : "no equilibrium under self-weight with N >= 0, |S| <= mu N");
   } else if (res.status == "optimal") {
     std::printf("lambda_la   %.6f  (rigid blocks, no tension, associative friction)\n",
                 res.lambda_la);

@@ -55,13 +55,13 @@
 namespace voussoir {
 
 struct PulseCriteria {
-  TrialCriteria settle;             // settling under gravity and the lambda ramp
-  double fall_displacement = 1.0;   // x L_ref
-  double fall_rotation = 1.0;       // [rad]
-  double rest_speed = 1e-3;         // x sqrt(g L_ref); 0.7 mm/s for scaled_arch
-  double hold_time = 0.05;          // [s]
-  double free_time = 1.5;           // [s] after the signal before the timeout decision
-  double sample_time = 1e-3;        // [s] between classification samples
+  TrialCriteria settle;            // settling under gravity and the lambda ramp
+  double fall_displacement = 1.0;  // x L_ref
+  double fall_rotation = 1.0;      // [rad]
+  double rest_speed = 1e-3;        // x sqrt(g L_ref); 0.7 mm/s for scaled_arch
+  double hold_time = 0.05;         // [s]
+  double free_time = 1.5;          // [s] after the signal before the timeout decision
+  double sample_time = 1e-3;       // [s] between classification samples
 };
 
 // A named point whose displacement relative to the table is recorded: the node of `block`
@@ -97,24 +97,24 @@ struct PulseSample {
 using PulseRecorder = std::function<void(const Simulation&, const PulseSample&)>;
 
 struct PulseResult {
-  double amplitude_g = 0.0;         // [g] (signal peak scale)
-  double frequency = 0.0;           // [Hz]
-  double signal_duration = 0.0;     // T [s]
+  double amplitude_g = 0.0;      // [g] (signal peak scale)
+  double frequency = 0.0;        // [Hz]
+  double signal_duration = 0.0;  // T [s]
   bool collapsed = false;
-  std::string reason;               // "fall", "rest", "timeout"
-  double decided_at = 0.0;          // signal time of the decision [s]
+  std::string reason;       // "fall", "rest", "timeout"
+  double decided_at = 0.0;  // signal time of the decision [s]
   long long steps = 0;
   double wall_s = 0.0;
-  double max_kinetic_energy = 0.0;  // [J]
+  double max_kinetic_energy = 0.0;        // [J]
   double energy_balance_error = 0.0;      // at the end
   double max_energy_balance_error = 0.0;  // largest over the samples
   double peak_energy = 0.0;               // ledger max energy [J]
-  double max_displacement = 0.0;    // largest block centroid displacement seen [m]
-  double max_rotation = 0.0;        // [rad]
-  double residual_displacement = 0.0;  // at the end [m]
-  double residual_rotation = 0.0;      // [rad]
+  double max_displacement = 0.0;          // largest block centroid displacement seen [m]
+  double max_rotation = 0.0;              // [rad]
+  double residual_displacement = 0.0;     // at the end [m]
+  double residual_rotation = 0.0;         // [rad]
   std::vector<ControlSummary> control;
-  std::vector<Hinge> hinges;        // joints open or slid at the end
+  std::vector<Hinge> hinges;  // joints open or slid at the end
 };
 
 // One pulse run from a copy of `settled`. `recorder` (optional) is called every
@@ -124,10 +124,10 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
                       const PulseRecorder& recorder = nullptr, double record_every = 1e-3);
 
 struct CurvePoint {
-  double frequency = 0.0;       // [Hz]
-  double amplitude = 0.0;       // [g] smallest collapsing amplitude found (hi)
-  double lo = 0.0, hi = 0.0;    // bracket [g]: survived at lo, collapsed at hi
-  bool bracketed = false;       // false: no collapse up to kMaxAmplitude
+  double frequency = 0.0;     // [Hz]
+  double amplitude = 0.0;     // [g] smallest collapsing amplitude found (hi)
+  double lo = 0.0, hi = 0.0;  // bracket [g]: survived at lo, collapsed at hi
+  bool bracketed = false;     // false: no collapse up to kMaxAmplitude
   int trials = 0;
   double wall_s = 0.0;
   double max_energy_balance_error = 0.0;  // over the trials
@@ -143,15 +143,15 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
                                    const PulseCriteria& criteria, bool quiet);
 
 struct PulseOptions {
-  std::string output;               // -o FILE: HDF5 of the single run
-  std::string series;               // --series FILE.csv: time series of the single run
-  bool curve = false;               // --curve
-  std::vector<double> freqs;        // --freqs F1,F2,... [Hz]
-  std::string csv;                  // --csv FILE (curve; default curve.csv)
-  std::string plot;                 // --plot FILE.png (curve, by scripts/plot_curve)
-  double lambda_star = -1.0;        // --lambda-star X: skip the capacity search (< 0: compute)
-  double tolerance = 0.02;          // --tolerance: relative bracket width on A
-  int points = 2;                   // --points: capacity trials per round
+  std::string output;         // -o FILE: HDF5 of the single run
+  std::string series;         // --series FILE.csv: time series of the single run
+  bool curve = false;         // --curve
+  std::vector<double> freqs;  // --freqs F1,F2,... [Hz]
+  std::string csv;            // --csv FILE (curve; default curve.csv)
+  std::string plot;           // --plot FILE.png (curve, by scripts/plot_curve)
+  double lambda_star = -1.0;  // --lambda-star X: skip the capacity search (< 0: compute)
+  double tolerance = 0.02;    // --tolerance: relative bracket width on A
+  int points = 2;             // --points: capacity trials per round
 };
 
 int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts);

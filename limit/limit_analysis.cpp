@@ -202,7 +202,7 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
     rc = glp_simplex(P, &parm);
   }
   int status = rc == 0 ? glp_get_status(P) : GLP_UNDEF;
-  if (rc == 0 && options.exact && glp_exact(P, &parm) == 0) {
+  if (rc == 0 && options.exact && res.rows <= options.exact_max_rows && glp_exact(P, &parm) == 0) {
     // The rational verdict (optimal / infeasible / unbounded) is the one reported. glp_exact
     // reads each double as the simplest fraction within 1e-9 relative of it (GLPK's set_d_eps),
     // so its values belong to data perturbed at that level: re-solve in floating point from
@@ -310,6 +310,12 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
       }
       res.mechanism.push_back(m);
     }
+    // Report order: by Model::joints index (along the arch for arch scenes), then the rest.
+    std::stable_sort(res.mechanism.begin(), res.mechanism.end(),
+                     [](const MechanismJoint& p, const MechanismJoint& q) {
+                       const bool pn = p.joint < 0, qn = q.joint < 0;
+                       return pn != qn ? qn : (!pn && p.joint < q.joint);
+                     });
   }
 
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -16,6 +16,7 @@
 namespace voussoir {
 
 // One joint of the collapse mechanism (fields as in the FDEM hinge report, drivers/kinematics).
+// LimitResult::mechanism is sorted by Model::joints index, interfaces without a joint last.
 struct MechanismJoint {
   Index interface = 0;  // index into LimitResult::interfaces
   Index joint = -1;     // index into Model::joints (-1: interface not in Model::joints)
@@ -63,10 +64,13 @@ struct LimitResult {
 };
 
 struct LimitOptions {
-  // Re-solve from the optimal floating-point basis with glp_exact (rational arithmetic), so
-  // the reported basis is exactly optimal/feasible for the (floating-point) data. Cheap from
-  // a warm basis: a few ms on the arches; tens to hundreds on the church.
+  // Confirm the simplex's status and basis with glp_exact (rational arithmetic, data read to
+  // 1e-9 relative), then report floating-point values from that basis (limit_analysis.cpp).
+  // A few ms on the arches, about 0.25-0.4 s of the church's 0.3-0.5 s.
   bool exact = true;
+  // ... but only for LPs of at most this many rows (3 per free block): the rational check
+  // grows about quadratically (0.4 s at 705 rows, 3.5 s at 2829 rows on the church).
+  int exact_max_rows = 2000;
   // Relative threshold, against the largest relative velocity, below which an interface end
   // is taken as not moving in the mechanism.
   double motion_tol = 1e-6;

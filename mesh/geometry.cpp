@@ -19,8 +19,7 @@ double outline_area(const Outline& outline) {
     const OutlineEdge& e = outline[i];
     const Vec2 q = outline[(i + 1) % n].start;
     twice += cross(e.start, q);
-    if (e.radius > 0.0)
-      segments += 0.5 * e.radius * e.radius * (e.sweep - std::sin(e.sweep));
+    if (e.radius > 0.0) segments += 0.5 * e.radius * e.radius * (e.sweep - std::sin(e.sweep));
   }
   return 0.5 * twice + segments;
 }
@@ -125,7 +124,8 @@ double triangle_overlap_area(const std::array<Vec2, 3>& t1, const std::array<Vec
   if (polygon_area(poly) < 0.0) std::swap(poly[1], poly[2]);
   std::array<Vec2, 3> clip = t2;
   if (cross(clip[1] - clip[0], clip[2] - clip[0]) < 0.0) std::swap(clip[1], clip[2]);
-  for (int k = 0; k < 3 && poly.size() >= 3; ++k) poly = clip_left(poly, clip[k], clip[(k + 1) % 3]);
+  for (int k = 0; k < 3 && poly.size() >= 3; ++k)
+    poly = clip_left(poly, clip[k], clip[(k + 1) % 3]);
   return poly.size() >= 3 ? std::max(0.0, polygon_area(poly)) : 0.0;
 }
 

@@ -49,8 +49,7 @@ double element_size(const Config& config, double reference) {
   return reference / n;
 }
 
-void choose_band_cells(double t, double length, double curvature_ratio, double h, int* n,
-                       int* m) {
+void choose_band_cells(double t, double length, double curvature_ratio, double h, int* n, int* m) {
   // Cell: b = t / n across, a = L / m along the centreline; along the intrados and extrados
   // the cell is a (1 -+ q) long, q = t / (2 R) the curvature ratio of the tightest arc.
   constexpr double kAspect = 1.8;  // largest side ratio accepted
@@ -65,6 +64,15 @@ void choose_band_cells(double t, double length, double curvature_ratio, double h
   } else if (a_out > kAspect * b) {
     *m = static_cast<int>(std::ceil(length * (1.0 + q) / (kTarget * b)));
   }
+}
+
+void check_triangle_budget(const Config& config, double estimate) {
+  if (estimate <= kMaxTriangles) return;
+  std::ostringstream why;
+  why << "would make about " << static_cast<long long>(estimate) << " triangles (limit "
+      << static_cast<long long>(kMaxTriangles) << "); use a coarser mesh";
+  if (config.mesh.size > 0.0) geometry_error(config, "mesh.size", config.mesh.size, why.str());
+  geometry_error(config, "mesh.through_thickness", config.mesh.through_thickness, why.str());
 }
 
 Scene build_scene(const Config& config) {
@@ -98,14 +106,7 @@ Model mesh_scene(Scene& scene, const Config& config) {
       estimate += 2.0 * static_cast<double>(b.columns.size()) * b.columns[0].size();
     }
   }
-  if (estimate > kMaxTriangles) {
-    std::ostringstream why;
-    why << "would make about " << static_cast<long long>(estimate) << " triangles (limit "
-        << static_cast<long long>(kMaxTriangles) << "); use a coarser mesh";
-    if (config.mesh.size > 0.0)
-      geometry_error(config, "mesh.size", config.mesh.size, why.str());
-    geometry_error(config, "mesh.through_thickness", config.mesh.through_thickness, why.str());
-  }
+  check_triangle_budget(config, estimate);
 
   // Mesh every block that is not a mirror first, then the mirrors.
   for (BlockSpec& b : scene.blocks) {

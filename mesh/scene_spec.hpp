@@ -5,6 +5,9 @@
 // outline areas, centreline geometry).
 //
 // Conventions shared by every generator (SPEC.md section 3):
+//   - a key the deck did not give (ModelConfig::given) takes the default of the scene kind
+//     where SPEC gives one that differs from io/config.hpp's: the church's thickness is 0.5 m
+//     and a block's height 1.0 m;
 //   - lengths in m, angles in the deck in degrees, here in radians unless the name says deg;
 //   - a scene that is mirror-symmetric has its axis at x = 0; the blocks of its left half are
 //     built as exact mirror images (sign of x flipped) of those of its right half, and blocks
@@ -41,13 +44,13 @@ struct BlockSpec {
   };
   std::string role;  // voussoir, crown, abutment, buttress, pier, ground, block
   bool fixed = false;
-  Outline outline;   // exact outline, counter-clockwise (arcs where the block has arcs)
+  Outline outline;  // exact outline, counter-clockwise (arcs where the block has arcs)
   Mesher mesher = Mesher::Polygon;
   std::vector<std::vector<Vec2>> columns;
   std::vector<Vec2> boundary;
   double size = 0.0;
   Index mirror_of = -1;
-  TriMesh mesh;      // filled by mesh_scene (or by the generator for Given)
+  TriMesh mesh;  // filled by mesh_scene (or by the generator for Given)
 };
 
 // One circular piece of an arch centreline, traversed from `start` by the signed `sweep` [rad]
@@ -63,8 +66,8 @@ struct Scene {
   std::string kind;
   std::vector<BlockSpec> blocks;
   std::vector<Joint> joints;
-  bool symmetric = false;             // mirror-symmetric about x = 0
-  double element_size = 0.0;          // target element size h used [m]
+  bool symmetric = false;     // mirror-symmetric about x = 0
+  double element_size = 0.0;  // target element size h used [m]
   // Rotation about the origin [rad, counter-clockwise] applied to every mesh after meshing
   // (block scene on an incline); outlines and joints are stored already rotated.
   double rotation = 0.0;
@@ -75,8 +78,8 @@ struct Scene {
   std::vector<ArcPiece> centreline;
   double centreline_length = 0.0;
   double arch_thickness = 0.0;
-  int through_thickness = 0;          // cells across the arch thickness (arch scenes)
-  int cells_along = 0;                // cells along each voussoir (arch scenes)
+  int through_thickness = 0;  // cells across the arch thickness (arch scenes)
+  int cells_along = 0;        // cells along each voussoir (arch scenes)
 };
 
 // Builds the scene of the deck's [model] (not yet meshed). Throws DeckError for a geometry
@@ -120,13 +123,24 @@ struct PointChain {
 };
 
 // Generators, one per kind (mesh/scenes_*.cpp).
-Scene build_arch_scene(const Config& config);        // circular_arch, basket_arch, buttressed
-Scene build_church_scene(const Config& config);      // church
-Scene build_block_scene(const Config& config);       // block
-Scene build_polygons_scene(const Config& config);    // polygons
+Scene build_arch_scene(const Config& config);      // circular_arch, basket_arch, buttressed
+Scene build_church_scene(const Config& config);    // church
+Scene build_block_scene(const Config& config);     // block
+Scene build_polygons_scene(const Config& config);  // polygons
 
-// Element size of the scene: mesh.size if given, else `reference / mesh.through_thickness`.
+// Element size h of the scene: mesh.size if given, else `reference / mesh.through_thickness`
+// (reference: the arch thickness; the block scene's min(width, height); the smallest free
+// polygon's narrowest side). h is the side of a structured cell (cells are then adjusted to
+// an aspect within 1 : 1.8, see choose_band_cells); blocks meshed by CGAL get a longest-edge
+// bound of sqrt(2) h, the diagonal of such a cell, with their boundary cut every h; fixed
+// blocks are three times coarser inside (3 sqrt(2) h) but keep the nodes of the free blocks'
+// faces on theirs.
 double element_size(const Config& config, double reference);
+
+// Throws DeckError naming mesh.size (or mesh.through_thickness) when a mesh of about
+// `estimate` triangles would exceed the generators' limit (4e6). Generators call it before
+// allocating a structured mesh.
+void check_triangle_budget(const Config& config, double estimate);
 
 // Throws DeckError "<deck>: model.<key> = <value>: <why>".
 [[noreturn]] void geometry_error(const Config& config, const std::string& key, double value,
@@ -139,7 +153,6 @@ double element_size(const Config& config, double reference);
 // cell aspect (along the intrados and the extrados, whose lengths are L (1 -+ q) with
 // q = t / (2 R) for the tightest centreline radius R; q = 0 for straight bands) stays within
 // 1 : 1.8, which keeps every triangle angle above about 25 degrees.
-void choose_band_cells(double t, double length, double curvature_ratio, double h, int* n,
-                       int* m);
+void choose_band_cells(double t, double length, double curvature_ratio, double h, int* n, int* m);
 
 }  // namespace voussoir

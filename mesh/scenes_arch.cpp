@@ -150,8 +150,10 @@ HalfCentreline basket_centreline(const Config& config) {
   if (!(r > 0.0 && r < rc))
     geometry_error(config, "model.small_radius", r,
                    "the small arcs must lie inside the reference circle: need 0 < r < "
-                   "model.radius = " + fmt(rc) + " m (their centres O3 = (Rc - r)(cos g, sin g) "
-                   "must differ from O)");
+                   "model.radius = " +
+                       fmt(rc) +
+                       " m (their centres O3 = (Rc - r)(cos g, sin g) "
+                       "must differ from O)");
   if (!(d > 0.0))
     geometry_error(config, "model.offset", d,
                    "the large arc's centre O1 = (0, -d) must lie below O (d > 0); with d <= 0 "
@@ -190,6 +192,7 @@ void add_voussoirs(const Config& config, const HalfCentreline& cl, Scene& scene,
   int n = 1, m = 1;
   choose_band_cells(t, 2.0 * cl.half_length / nv, 0.5 * t / cl.min_radius, h, &n, &m);
 
+  check_triangle_budget(config, 2.0 * nv * (static_cast<double>(n) * m + n));
   const long long nm = static_cast<long long>(nv) * m;
   const double du = cl.half_length / static_cast<double>(nm);
   const double dw = t / (2.0 * n);
@@ -209,7 +212,8 @@ void add_voussoirs(const Config& config, const HalfCentreline& cl, Scene& scene,
                      cols.begin() + static_cast<long long>(k + 1) * m + 1);
     // Exact outline: intrados left to right (clockwise arcs), joint, extrados right to left
     // (counter-clockwise arcs), joint. Arc edges split where the centreline changes piece.
-    const double ua = u_of(static_cast<long long>(k) * m), ub = u_of(static_cast<long long>(k + 1) * m);
+    const double ua = u_of(static_cast<long long>(k) * m),
+                 ub = u_of(static_cast<long long>(k + 1) * m);
     std::vector<double> us{ua};
     for (double br : breaks)
       if (br > ua && br < ub) us.push_back(br);
@@ -305,12 +309,14 @@ void add_buttresses(const Config& config, Scene& scene, const std::vector<Vec2>&
   if (!(bw > joint_dx * (1.0 + 1e-9)))
     geometry_error(config, "model.buttress_width", bw,
                    "the buttress must reach past the extrados springing: B must exceed the "
-                   "springing joint's horizontal extent " + fmt(joint_dx) + " m");
+                   "springing joint's horizontal extent " +
+                       fmt(joint_dx) + " m");
   const double y_low = std::min(ip.y, ep.y);
   if (!(-h1 < y_low - 1e-9 * mc.thickness))
     geometry_error(config, "model.base_depth", h1,
                    "the ground line y = -H1 must lie below the springing (lowest springing "
-                   "point at y = " + fmt(y_low) + " m)");
+                   "point at y = " +
+                       fmt(y_low) + " m)");
   const double xi = ip.x, xo = ip.x + bw, yg = -h1;
 
   // Course cuts from the ground up, strictly below the lowest springing point.
@@ -346,7 +352,8 @@ void add_buttresses(const Config& config, Scene& scene, const std::vector<Vec2>&
       c.segment({xo, cuts[k]}, {xo, cuts[k + 1]}, h);
       c.add_reversed(rows[k + 1]);
       c.segment({xi, cuts[k + 1]}, {xi, cuts[k]}, h);
-      b.outline = polygon_outline({{xi, cuts[k]}, {xo, cuts[k]}, {xo, cuts[k + 1]}, {xi, cuts[k + 1]}});
+      b.outline =
+          polygon_outline({{xi, cuts[k]}, {xo, cuts[k]}, {xo, cuts[k + 1]}, {xi, cuts[k + 1]}});
     } else {
       c.segment({xo, cuts[k]}, {xo, ep.y}, h);
       c.segment({xo, ep.y}, ep, h);
@@ -358,7 +365,8 @@ void add_buttresses(const Config& config, Scene& scene, const std::vector<Vec2>&
     courses.push_back(std::move(b));
   }
   // Left buttress (mirror images) first, then the right one, then the ground.
-  const Index left0 = nv, right0 = nv + static_cast<Index>(nc), ground = nv + 2 * static_cast<Index>(nc);
+  const Index left0 = nv, right0 = nv + static_cast<Index>(nc),
+              ground = nv + 2 * static_cast<Index>(nc);
   for (std::size_t k = 0; k < nc; ++k) {
     BlockSpec l;
     l.role = "buttress";
@@ -409,11 +417,13 @@ Scene build_arch_scene(const Config& config) {
   if (mc.kind == "buttressed_arch") {
     shape = mc.shape;
     if (shape != "circular" && shape != "basket")
-      geometry_error(config, "model.shape", "\"" + shape + "\"", "expected \"circular\" or \"basket\"");
+      geometry_error(config, "model.shape", "\"" + shape + "\"",
+                     "expected \"circular\" or \"basket\"");
   }
   if (!(mc.embrace > 0.0 && mc.embrace < 360.0))
     geometry_error(config, "model.embrace", mc.embrace, "expected an angle in (0, 360) degrees");
-  const HalfCentreline cl = shape == "circular" ? circular_centreline(config) : basket_centreline(config);
+  const HalfCentreline cl =
+      shape == "circular" ? circular_centreline(config) : basket_centreline(config);
 
   Scene scene;
   std::vector<Vec2> left, right;

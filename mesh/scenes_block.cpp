@@ -26,13 +26,17 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kFixedCoarsening = 3.0;
 
-Vec2 rotate(Vec2 p, double c, double s) { return {c * p.x - s * p.y, s * p.x + c * p.y}; }
+Vec2 rotate(Vec2 p, double c, double s) {
+  return {c * p.x - s * p.y, s * p.x + c * p.y};
+}
 
 }  // namespace
 
 Scene build_block_scene(const Config& config) {
   const ModelConfig& mc = config.model;
-  const double w = mc.width, ht = mc.height, incline = mc.incline;
+  // SPEC gives no block height; io/config's 5.0 is the church's. A block deck without
+  // `height` gets a 1.0 m block.
+  const double w = mc.width, ht = mc.has("height") ? mc.height : 1.0, incline = mc.incline;
   const int stack = mc.stack;
   if (!(w > 0.0)) geometry_error(config, "model.width", w, "expected a width > 0 m");
   if (!(ht > 0.0)) geometry_error(config, "model.height", ht, "expected a height > 0 m");
@@ -43,6 +47,7 @@ Scene build_block_scene(const Config& config) {
   const double h = element_size(config, std::min(w, ht));
   int n = 1, m = 1;  // n rows up the height, m columns across the width
   choose_band_cells(ht, w, 0.0, h, &n, &m);
+  check_triangle_budget(config, 2.0 * stack * (static_cast<double>(n) * m + n));
 
   Scene scene;
   scene.element_size = h;
@@ -57,14 +62,12 @@ Scene build_block_scene(const Config& config) {
     b.mesher = BlockSpec::Mesher::Band;
     for (int j = 0; j <= m; ++j) {
       std::vector<Vec2> col(n + 1);
-      for (int i = 0; i <= n; ++i)
-        col[i] = {xs[j], i == n ? y1 : y0 + (i * ht) / n};
+      for (int i = 0; i <= n; ++i) col[i] = {xs[j], i == n ? y1 : y0 + (i * ht) / n};
       b.columns.push_back(std::move(col));
     }
     b.outline = polygon_outline({{xs[0], y0}, {xs[m], y0}, {xs[m], y1}, {xs[0], y1}});
     scene.blocks.push_back(std::move(b));
-    if (k > 0)
-      scene.joints.push_back(Joint{k - 1, k, {xs[0], y0}, {xs[m], y0}, kNaN});
+    if (k > 0) scene.joints.push_back(Joint{k - 1, k, {xs[0], y0}, {xs[m], y0}, kNaN});
   }
 
   // Ground: right chain from (0, -depth) to (0, 0), keeping the base nodes of block 0.

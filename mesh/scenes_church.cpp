@@ -108,7 +108,9 @@ Scene build_church_scene(const Config& config) {
   const std::vector<double>& spans = mc.spans;
   const int ns = static_cast<int>(spans.size());
   const double pier = mc.pier_width, outer = mc.outer_width, height = mc.height;
-  const double t = mc.thickness, ecc = mc.eccentricity, dtheta = mc.voussoir_angle * kDeg;
+  // SPEC's church thickness default (0.5 m) differs from the arches' (io/config: 0.2 m).
+  const double t = mc.has("thickness") ? mc.thickness : 0.5, ecc = mc.eccentricity,
+               dtheta = mc.voussoir_angle * kDeg;
   const double hc = mc.courses;
   if (ns < 1) geometry_error(config, "model.spans", "[]", "expected at least one span");
   for (double s : spans)
@@ -121,12 +123,13 @@ Scene build_church_scene(const Config& config) {
   if (!(outer >= t * (1.0 - kTight)))
     geometry_error(config, "model.outer_width", outer,
                    "an outer buttress must carry its arch's springing joint: it must be at least "
-                   "model.thickness = " + fmt(t) + " m wide");
+                   "model.thickness = " +
+                       fmt(t) + " m wide");
   if (ns > 1 && !(pier >= 2.0 * t * (1.0 - kTight)))
     geometry_error(config, "model.pier_width", pier,
                    "too narrow for its two springings: a pier carries two springing joints of "
-                   "model.thickness = " + fmt(t) + " m each, so it must be at least " +
-                       fmt(2.0 * t) + " m wide");
+                   "model.thickness = " +
+                       fmt(t) + " m each, so it must be at least " + fmt(2.0 * t) + " m wide");
   if (!(height > 0.0)) geometry_error(config, "model.height", height, "expected a height > 0 m");
   if (!(ecc >= 0.0)) geometry_error(config, "model.eccentricity", ecc, "expected a value >= 0");
   if (!(dtheta > 0.0 && dtheta < 0.5 * kPi))
@@ -190,14 +193,18 @@ Scene build_church_scene(const Config& config) {
     int kh = static_cast<int>(std::floor(th_i / dtheta));
     if (th_i - kh * dtheta < 0.5 * dtheta) --kh;
     kh = std::max(kh, 0);
+    if (kh > 100000)
+      geometry_error(config, "model.voussoir_angle", mc.voussoir_angle,
+                     "makes more than 100000 voussoirs per half arch");
     int n = 1, m = 1;
     choose_band_cells(t, (ri + 0.5 * t) * dtheta, 0.5 * t / (ri + 0.5 * t), h, &n, &m);
+    check_triangle_budget(config, 4.0 * kh * (static_cast<double>(n) * m + n));
     const double ya_i = height + std::sqrt(ri * ri - c * c);
     const double ya_e = height + std::sqrt(re * re - c * c);
     const Vec2 apex_i{xm, ya_i}, apex_e{xm, ya_e};
     const double crl = xm - c, cll = xm + c;  // x of C_R and C_L
     auto rho = [&](int i) { return i == n ? re : ri + (i * t) / n; };
-    // side +1: right half, -1: left half. Column J at theta = J D / m.
+    // side +1: right half, -1: left half; column j at theta = j D / m, row i at radius rho(i).
     // Point at angle th and radius r on one half. Explicit fma: GCC contracts a + r cos into
     // an fma at some call sites and not at others (-ffp-contract=fast is its default), which
     // would break the bit-exact mirror pairs; with fma(-r, c, cll) = -fma(r, c, -cll) the
@@ -209,10 +216,15 @@ Scene build_church_scene(const Config& config) {
     };
     // Extrados springing points: t beyond the faces, or exactly the meeting point when the
     // support is just wide enough (see the validation above).
-    auto tight = [&](const Support& sp) { return sp.xr - sp.xl <= (&sp == &sup.front() || &sp == &sup.back() ? 1.0 : 2.0) * t * (1.0 + kTight); };
+    auto tight = [&](const Support& sp) {
+      return sp.xr - sp.xl <=
+             (&sp == &sup.front() || &sp == &sup.back() ? 1.0 : 2.0) * t * (1.0 + kTight);
+    };
     const Support &sl = sup[s], &sr = sup[s + 1];
-    const double xe_left = !tight(sl) ? a - t : (&sl == &sup.front() ? sl.xl : 0.5 * (sl.xl + sl.xr));
-    const double xe_right = !tight(sr) ? b + t : (&sr == &sup.back() ? sr.xr : 0.5 * (sr.xl + sr.xr));
+    const double xe_left =
+        !tight(sl) ? a - t : (&sl == &sup.front() ? sl.xl : 0.5 * (sl.xl + sl.xr));
+    const double xe_right =
+        !tight(sr) ? b + t : (&sr == &sup.back() ? sr.xr : 0.5 * (sr.xl + sr.xr));
     auto point = [&](int side, long long j, int i) -> Vec2 {
       if (j == 0 && i == n) return {side > 0 ? xe_right : xe_left, height};
       if (j == 0) return side > 0 ? Vec2{b + (i * t) / n, height} : Vec2{a - (i * t) / n, height};
@@ -249,13 +261,14 @@ Scene build_church_scene(const Config& config) {
       crown.role = "crown";
       crown.mesher = BlockSpec::Mesher::Polygon;
       crown.size = std::sqrt(2.0) * h;
-      // Right chain: apex intrados -> right intrados down -> right joint up -> right extrados
-      // up -> apex extrados; the left chain is its mirror about x = xm, computed with the left
-      // formula.
+      // Counter-clockwise: right joint face up, right extrados up to the apex, left extrados
+      // down, left joint face down, left intrados up to the apex notch, right intrados down.
+      // (With kh = 0 the crown is the whole arch and its joint faces are the springings.)
       auto arc = [&](int side, double r, double th0, double th1, std::vector<Vec2>& out) {
         // Points strictly between th0 and th1 on the arc of radius r (parts no longer than h).
         const int parts = std::max(1, static_cast<int>(std::ceil(r * std::abs(th1 - th0) / h)));
-        for (int q = 1; q < parts; ++q) out.push_back(polar(side, r, th0 + (th1 - th0) * q / parts));
+        for (int q = 1; q < parts; ++q)
+          out.push_back(polar(side, r, th0 + (th1 - th0) * q / parts));
       };
       std::vector<Vec2> bnd;
       bnd.push_back(fr[0]);
@@ -268,16 +281,10 @@ Scene build_church_scene(const Config& config) {
       bnd.push_back(apex_i);
       arc(+1, ri, th_i, th_k, bnd);
       crown.boundary = bnd;
-      crown.outline = {OutlineEdge{fr[0], 0.0, {}, 0.0},
-                       OutlineEdge{fr[n], re, cr, th_e - th_k},
-                       OutlineEdge{apex_e, re, cl, th_e - th_k},
-                       OutlineEdge{fl[n], 0.0, {}, 0.0},
-                       OutlineEdge{fl[0], ri, cl, th_k - th_i},
-                       OutlineEdge{apex_i, ri, cr, th_k - th_i}};
-      if (kh == 0) {
-        // One block from springing to springing: the springing joints are its joint faces.
-        crown.role = "crown";
-      }
+      crown.outline = {
+          OutlineEdge{fr[0], 0.0, {}, 0.0},         OutlineEdge{fr[n], re, cr, th_e - th_k},
+          OutlineEdge{apex_e, re, cl, th_e - th_k}, OutlineEdge{fl[n], 0.0, {}, 0.0},
+          OutlineEdge{fl[0], ri, cl, th_k - th_i},  OutlineEdge{apex_i, ri, cr, th_k - th_i}};
       ab.blocks.push_back(std::move(crown));
     }
     for (int k = kh - 1; k >= 0; --k) {
@@ -356,8 +363,8 @@ Scene build_church_scene(const Config& config) {
     const Index first = static_cast<Index>(scene.blocks.size());
     const Index count = static_cast<Index>(arches[s].blocks.size());
     for (BlockSpec& b : arches[s].blocks) scene.blocks.push_back(std::move(b));
-    scene.joints.push_back(Joint{sup[s].blocks.back(), first, faces[s].left.front(),
-                                 faces[s].left.back(), 0.0});
+    scene.joints.push_back(
+        Joint{sup[s].blocks.back(), first, faces[s].left.front(), faces[s].left.back(), 0.0});
     for (Joint j : arches[s].joints) {
       j.block_a += first;
       j.block_b += first;
@@ -393,8 +400,8 @@ Scene build_church_scene(const Config& config) {
     const Index gi = static_cast<Index>(scene.blocks.size());
     scene.blocks.push_back(std::move(g));
     for (int i = 0; i <= ns; ++i)
-      scene.joints.push_back(Joint{gi, sup[i].blocks.front(), {sup[i].xl, 0.0},
-                                   {sup[i].xr, 0.0}, kNaN});
+      scene.joints.push_back(
+          Joint{gi, sup[i].blocks.front(), {sup[i].xl, 0.0}, {sup[i].xr, 0.0}, kNaN});
   }
 
   // Symmetric church: blocks left of the axis become mirror images of their right partners,
@@ -417,7 +424,8 @@ Scene build_church_scene(const Config& config) {
         Index partner = -1;
         for (std::size_t j = 0; j < scene.blocks.size() && partner < 0; ++j) {
           const BlockSpec& c = scene.blocks[j];
-          if (j == i || c.mesher != BlockSpec::Mesher::Polygon || c.outline.size() != mirrored.size())
+          if (j == i || c.mesher != BlockSpec::Mesher::Polygon ||
+              c.outline.size() != mirrored.size())
             continue;
           bool same = true;
           for (const OutlineEdge& e : mirrored) {

@@ -21,8 +21,9 @@
 //        -0.25 1
 //    Each block is meshed by the constrained quality mesher with elements about mesh.size (or,
 //    without it, the smallest free block's narrowest bounding-box side / through_thickness).
-//    Edges are cut from their lexicographically smaller end, so two blocks that share an
-//    edge get the same nodes on it.
+//    A vertex of one block lying on an edge of another (a T-junction) becomes a node of both,
+//    and edges are cut from their lexicographically smaller end, so two blocks that share a
+//    face get the same nodes on it.
 //
 // 2. gmsh MSH 4.1 ASCII. Every 3-node triangle (element type 2) on a surface belongs to the
 //    block of that surface's (first) physical tag; blocks are numbered in ascending physical
@@ -119,7 +120,8 @@ std::vector<std::vector<Vec2>> read_polygon_text(const std::string& text, const 
     if (p.size() < 3)
       throw FileError{where + "a block needs at least 3 vertices, got " + std::to_string(p.size())};
     if (!polygon_is_simple(p))
-      throw FileError{where + "the polygon is not simple (edges cross or touch, or a vertex repeats)"};
+      throw FileError{where +
+                      "the polygon is not simple (edges cross or touch, or a vertex repeats)"};
     if (polygon_area(p) < 0.0) std::reverse(p.begin(), p.end());
   }
   return blocks;
@@ -194,8 +196,8 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
     } else if (tok == "$Elements") {
       std::size_t nblocks = 0, nel = 0, mintag = 0, maxtag = 0;
       if (!(in >> nblocks >> nel >> mintag >> maxtag)) fail("unreadable $Elements");
-      static const std::map<int, int> nodes_of = {{1, 2}, {2, 3}, {3, 4}, {4, 4}, {8, 3},
-                                                  {9, 6}, {10, 9}, {15, 1}, {16, 8}, {20, 9},
+      static const std::map<int, int> nodes_of = {{1, 2},   {2, 3},  {3, 4},  {4, 4},  {8, 3},
+                                                  {9, 6},   {10, 9}, {15, 1}, {16, 8}, {20, 9},
                                                   {21, 10}, {26, 4}, {27, 5}, {28, 6}};
       for (std::size_t b = 0; b < nblocks; ++b) {
         int dim, tag, type;
@@ -204,8 +206,8 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
         const auto it = nodes_of.find(type);
         if (it == nodes_of.end()) fail("unknown element type " + std::to_string(type));
         if (dim == 2 && type != 2)
-          fail("surface " + std::to_string(tag) + " has elements of type " +
-               std::to_string(type) + "; only 3-node triangles (type 2) are supported");
+          fail("surface " + std::to_string(tag) + " has elements of type " + std::to_string(type) +
+               "; only 3-node triangles (type 2) are supported");
         if (dim == 3) fail("3D elements found; voussoir reads 2D triangle meshes");
         for (std::size_t k = 0; k < count; ++k) {
           std::size_t id;
@@ -253,7 +255,8 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
       std::array<Index, 3> tri{};
       for (int q = 0; q < 3; ++q) {
         const auto it = nodes.find(t[q]);
-        if (it == nodes.end()) fail("element refers to node " + std::to_string(t[q]) + " not in $Nodes");
+        if (it == nodes.end())
+          fail("element refers to node " + std::to_string(t[q]) + " not in $Nodes");
         if (std::abs(it->second[2]) > 1e-9 * std::max(scale, 1.0))
           fail("node " + std::to_string(t[q]) + " has z = " + std::to_string(it->second[2]) +
                "; the mesh must lie in the plane z = 0");
@@ -262,7 +265,8 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
         tri[q] = pos->second;
       }
       const Vec2 a = mesh.points[tri[0]], b = mesh.points[tri[1]], c = mesh.points[tri[2]];
-      if (cross(b - a, c - a) == 0.0) fail("block with tag " + std::to_string(tag) + " has a degenerate triangle");
+      if (cross(b - a, c - a) == 0.0)
+        fail("block with tag " + std::to_string(tag) + " has a degenerate triangle");
       mesh.tris.push_back(tri);
     }
     out.meshes.push_back(std::move(mesh));
@@ -316,7 +320,8 @@ Scene build_polygons_scene(const Config& config) {
   const ModelConfig& mc = config.model;
   namespace fs = std::filesystem;
   if (mc.file.empty())
-    geometry_error(config, "model.file", "\"\"", "model.kind = \"polygons\" needs a file of blocks");
+    geometry_error(config, "model.file", "\"\"",
+                   "model.kind = \"polygons\" needs a file of blocks");
   fs::path path(mc.file);
   if (path.is_relative() && !fs::exists(path) && !config.deck_dir.empty())
     path = fs::path(config.deck_dir) / path;
@@ -366,7 +371,8 @@ Scene build_polygons_scene(const Config& config) {
                      "no such block: the file has " + std::to_string(nb) + " blocks (indices 0.." +
                          std::to_string(nb - 1) + ")");
   for (std::size_t b = 0; b < nb; ++b) {
-    const bool fixed = std::find(mc.fixed.begin(), mc.fixed.end(), static_cast<int>(b)) != mc.fixed.end();
+    const bool fixed =
+        std::find(mc.fixed.begin(), mc.fixed.end(), static_cast<int>(b)) != mc.fixed.end();
     scene.blocks[b].fixed = fixed;
     scene.blocks[b].role = fixed ? "ground" : "block";
   }
@@ -388,23 +394,45 @@ Scene build_polygons_scene(const Config& config) {
   }
   const double h = element_size(config, reference);
   scene.element_size = h;
+  // Conforming faces: a vertex of another block lying on an edge (a T-junction, e.g. a block
+  // standing on a longer ground edge) is inserted into that edge, so both blocks get a node
+  // there; then every edge is cut from its lexicographically smaller end so that a face shared
+  // by two blocks gets the same nodes on both.
   for (std::size_t b = 0; b < nb; ++b) {
     BlockSpec& spec = scene.blocks[b];
     if (spec.mesher != BlockSpec::Mesher::Polygon) continue;
     const auto& p = outlines[b];
     spec.size = (spec.fixed ? kFixedCoarsening : 1.0) * std::sqrt(2.0) * h;
-    // Cut each edge from its lexicographically smaller end so shared edges match.
     for (std::size_t e = 0; e < p.size(); ++e) {
       const Vec2 a = p[e], c = p[(e + 1) % p.size()];
-      const bool forward = a.x < c.x || (a.x == c.x && a.y < c.y);
-      std::vector<Vec2> cut;
-      append_segment(cut, forward ? a : c, forward ? c : a, h);
-      if (forward) {
-        spec.boundary.insert(spec.boundary.end(), cut.begin(), cut.end());
-      } else {
-        cut.push_back(a);  // from c .. a inclusive, reversed below, then drop c
-        std::reverse(cut.begin(), cut.end());
-        cut.pop_back();
+      const Vec2 ac = c - a;
+      const double len2 = dot(ac, ac), tol = 1e-9 * std::sqrt(len2);
+      std::vector<std::pair<double, Vec2>> stops;  // (parameter along a-c, point)
+      for (std::size_t o = 0; o < nb; ++o) {
+        if (o == b) continue;
+        for (const Vec2& q : outlines[o]) {
+          const double s = dot(q - a, ac) / len2;
+          if (s * std::sqrt(len2) <= tol || (1.0 - s) * std::sqrt(len2) <= tol) continue;
+          if (distance_to_segment(q, a, c) <= tol) stops.emplace_back(s, q);
+        }
+      }
+      std::sort(stops.begin(), stops.end(),
+                [](const auto& l, const auto& r) { return l.first < r.first; });
+      std::vector<Vec2> corners{a};
+      for (const auto& st : stops)
+        if (st.second.x != corners.back().x || st.second.y != corners.back().y)
+          corners.push_back(st.second);
+      corners.push_back(c);
+      for (std::size_t k = 0; k + 1 < corners.size(); ++k) {
+        const Vec2 u = corners[k], v = corners[k + 1];
+        const bool forward = u.x < v.x || (u.x == v.x && u.y < v.y);
+        std::vector<Vec2> cut;
+        append_segment(cut, forward ? u : v, forward ? v : u, h);
+        if (!forward) {
+          cut.push_back(u);  // v .. u inclusive; reversed it runs u .. v, then v is dropped
+          std::reverse(cut.begin(), cut.end());
+          cut.pop_back();
+        }
         spec.boundary.insert(spec.boundary.end(), cut.begin(), cut.end());
       }
     }

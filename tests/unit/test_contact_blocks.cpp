@@ -7,6 +7,7 @@
 // Lame lambda) so that each test runs in about a second; dt = 0.5 x stable_time_step, the
 // safety factor of the shipped decks.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -14,6 +15,8 @@
 
 #include "contact/contact.hpp"
 #include "core/step.hpp"
+#include "drivers/setup.hpp"
+#include "io/deck.hpp"
 
 using namespace voussoir;
 
@@ -367,4 +370,96 @@ TEST(ContactBlocks, OmegaEstimateBoundsTrueContactFrequency) {
     EXPECT_GE(estimate, lambda_max);
     EXPECT_LT(estimate, 4.0 * lambda_max);
   }
+}
+
+// The same incline checks through the shipped scene (cases/block.toml, kind = "block" with
+// `incline`; the generator rotates the scene counter-clockwise, so the block slides towards
+// -x) and make_simulation (deck penalty, damping and dt).
+TEST(ContactBlocks, ShippedBlockSceneOnIncline) {
+  for (const auto& [incline, mu] : {std::pair{20.0, 0.6}, std::pair{30.0, 0.3}}) {
+    const Config config =
+        load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml",
+                  {"model.height=0.5", "model.incline=" + std::to_string(incline),
+                   "contact.friction=" + std::to_string(mu), "mesh.through_thickness=2"});
+    Simulation sim = make_simulation(config);
+    Index block = -1;
+    for (Index b = 0; b < static_cast<Index>(sim.model.blocks.size()); ++b)
+      if (!sim.model.blocks[b].fixed) block = b;
+    ASSERT_GE(block, 0);
+    const double th = incline * std::numbers::pi / 180.0;
+    const Vec2 down{-std::cos(th), -std::sin(th)};
+    const BlockState s0 = block_state(sim, block);
+    run_for(sim, 0.1);
+    const BlockState s1 = block_state(sim, block);
+    const double t1 = sim.ctx.time;
+    run_for(sim, 0.4);
+    const BlockState s2 = block_state(sim, block);
+    const double t2 = sim.ctx.time;
+    if (std::tan(th) < mu) {
+      const double moved = std::hypot(s2.position.x - s0.position.x, s2.position.y - s0.position.y);
+      std::printf("shipped scene, incline %.0f mu %.1f: moved %.3e m in %.2f s\n", incline, mu,
+                  moved, t2);
+      EXPECT_LT(moved, 1e-6);
+    } else {
+      const double v1 = s1.velocity.x * down.x + s1.velocity.y * down.y;
+      const double v2 = s2.velocity.x * down.x + s2.velocity.y * down.y;
+      const double a = (v2 - v1) / (t2 - t1);
+      const double expected = kG * (std::sin(th) - mu * std::cos(th));
+      std::printf("shipped scene, incline %.0f mu %.1f: a = %.5f, expected %.5f\n", incline, mu, a,
+                  expected);
+      EXPECT_NEAR(a, expected, 0.02 * expected);
+    }
+  }
+}
+
+// Results do not depend on the thread count: a lattice of 12 x 12 blocks pressed into their
+// neighbours (several hundred candidate pairs, above the parallel threshold) with friction;
+// 20 contact evaluations with moving nodes (slip history evolving) give bit-identical forces,
+// energies and dissipation on 1 and on 3 threads.
+TEST(ContactBlocks, ThreadCountDoesNotChangeResults) {
+  Model base;
+  add_rectangle(base, -0.1, -0.1, 1.5, 0.1, 12, 1, true, "ground");
+  for (int j = 0; j < 12; ++j)
+    for (int i = 0; i < 12; ++i)
+      add_rectangle(base, i * (0.1 - 1e-5), j * (0.1 - 1e-5) - 1e-5, 0.1, 0.1, 1, 1, false,
+                    "block");
+  base.material.young = 40e9;
+  finalize_model(base);
+  auto run = [&](int threads, std::vector<double>& out) {
+    omp_set_num_threads(threads);
+    Model m = base;
+    ContactSystem c;
+    ContactParams cp;
+    cp.penalty = 1e12;
+    cp.friction = 0.5;
+    c.setup(m, cp);
+    EnergyLedger ledger;
+    for (int it = 0; it < 20; ++it) {
+      for (Index i = 0; i < m.nodes.size(); ++i) {
+        if (m.nodes.inv_mass[i] == 0.0) continue;
+        m.nodes.vx[i] = 1e-3 * std::sin(0.37 * i + it);
+        m.nodes.vy[i] = 1e-3 * std::cos(0.21 * i - it);
+        m.nodes.x[i] += 1e-6 * m.nodes.vx[i];
+        m.nodes.y[i] += 1e-6 * m.nodes.vy[i];
+      }
+      if (c.needs_detection(m.nodes)) c.detect(m);
+      std::fill(m.nodes.fx.begin(), m.nodes.fx.end(), 0.0);
+      std::fill(m.nodes.fy.begin(), m.nodes.fy.end(), 0.0);
+      c.add_forces(m, 1e-6, ledger);
+    }
+    out = m.nodes.fx;
+    out.insert(out.end(), m.nodes.fy.begin(), m.nodes.fy.end());
+    out.push_back(ledger.contact);
+    out.push_back(ledger.friction_dissipated);
+    out.push_back(static_cast<double>(c.active_pairs()));
+    EXPECT_GT(c.candidate_pairs(), 128);
+    EXPECT_GT(ledger.friction_dissipated, 0.0);
+  };
+  const int saved = omp_get_max_threads();
+  std::vector<double> one, three;
+  run(1, one);
+  run(3, three);
+  omp_set_num_threads(saved);
+  ASSERT_EQ(one.size(), three.size());
+  for (std::size_t k = 0; k < one.size(); ++k) ASSERT_EQ(one[k], three[k]) << "entry " << k;
 }

@@ -137,8 +137,8 @@ TEST(MeshBand, RectangleCountsAreaAndMirror) {
 TEST(Triangulate, NonConvexPolygonKeepsBoundaryAndQuality) {
   // L-shape (one reflex corner) and a pointed-crown-like block whose intrados has a notch.
   const std::vector<Vec2> ell = {{0, 0}, {2, 0}, {2, 0.7}, {0.6, 0.7}, {0.6, 1.9}, {0, 1.9}};
-  const std::vector<Vec2> crown = {{0.3, 0.0}, {0.45, 0.5}, {0.0, 0.62}, {-0.45, 0.5}, {-0.3, 0.0},
-                             {0.0, 0.12}};
+  const std::vector<Vec2> crown = {{0.3, 0.0},   {0.45, 0.5}, {0.0, 0.62},
+                                   {-0.45, 0.5}, {-0.3, 0.0}, {0.0, 0.12}};
   for (const std::vector<Vec2>* poly : {&ell, &crown}) {
     const double size = 0.1;
     const TriMesh mesh = triangulate_polygon(*poly, size);
@@ -177,8 +177,8 @@ TEST(Triangulate, SymmetricPolygonMirrorsExactly) {
   const std::vector<Vec2> right = {{0.0, 0.12}, {0.3, 0.0}, {0.45, 0.5}, {0.0, 0.62}};
   const TriMesh mesh = triangulate_symmetric(right, 0.08);
   EXPECT_TRUE(mirrors_exactly(mesh));
-  const std::vector<Vec2> whole = {{0.3, 0.0}, {0.45, 0.5}, {0.0, 0.62}, {-0.45, 0.5}, {-0.3, 0.0},
-                                   {0.0, 0.12}};
+  const std::vector<Vec2> whole = {{0.3, 0.0},   {0.45, 0.5}, {0.0, 0.62},
+                                   {-0.45, 0.5}, {-0.3, 0.0}, {0.0, 0.12}};
   EXPECT_NEAR(mesh_area(mesh), polygon_area(whole), 1e-13);
   EXPECT_NEAR(polygon_area(boundary_loop(mesh)), polygon_area(whole), 1e-13);
   EXPECT_GE(mesh_min_angle(mesh), 20.0);
@@ -195,7 +195,8 @@ TEST(Triangulate, BoundaryLoopRefusesHoles) {
   // A square ring of 8 triangles around a hole: two boundary loops.
   TriMesh ring;
   ring.points = {{0, 0}, {3, 0}, {3, 3}, {0, 3}, {1, 1}, {2, 1}, {2, 2}, {1, 2}};
-  ring.tris = {{0, 1, 5}, {0, 5, 4}, {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  ring.tris = {{0, 1, 5}, {0, 5, 4}, {1, 2, 6}, {1, 6, 5},
+               {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
   EXPECT_THROW(boundary_loop(ring), std::invalid_argument);
   // Without the hole's triangles removed, i.e. a plain square, one CCW loop of area 9.
   TriMesh sq;
@@ -207,7 +208,8 @@ TEST(Triangulate, BoundaryLoopRefusesHoles) {
 TEST(Triangulate, MeshOverlapArea) {
   const TriMesh a = triangulate_polygon({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, 0.2);
   const TriMesh touching = triangulate_polygon({{1, 0}, {2, 0}, {2, 1}, {1, 1}}, 0.2);
-  const TriMesh shifted = triangulate_polygon({{0.75, 0.5}, {1.75, 0.5}, {1.75, 1.5}, {0.75, 1.5}}, 0.2);
+  const TriMesh shifted =
+      triangulate_polygon({{0.75, 0.5}, {1.75, 0.5}, {1.75, 1.5}, {0.75, 1.5}}, 0.2);
   EXPECT_LT(mesh_overlap_area(a, touching), 1e-15);
   EXPECT_NEAR(mesh_overlap_area(a, shifted), 0.25 * 0.5, 1e-13);
 }

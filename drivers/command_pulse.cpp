@@ -1,0 +1,338 @@
+// `voussoir pulse DECK`: one base-excitation run (JSON, optional HDF5 and CSV series), or with
+// --curve the amplitude-frequency failure curve (CSV, plot, JSON). Criteria in pulse.hpp.
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "drivers/pulse.hpp"
+#include "drivers/run.hpp"
+#include "drivers/setup.hpp"
+#include "io/deck.hpp"
+#include "io/hdf5_output.hpp"
+#include "io/json.hpp"
+
+namespace voussoir {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+nlohmann::json hinges_json(const std::vector<Hinge>& hinges) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Hinge& h : hinges)
+    out.push_back({{"joint", h.joint},
+                   {"blocks", {h.block_a, h.block_b}},
+                   {"kind", h.kind},
+                   {"side", h.side},
+                   {"position_deg", h.position_deg},
+                   {"x", h.x},
+                   {"y", h.y},
+                   {"opening", h.opening},
+                   {"slip", h.slip}});
+  return out;
+}
+
+nlohmann::json control_json(const std::vector<ControlSummary>& control) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const ControlSummary& c : control)
+    out[c.point.name] = {{"block", c.point.block},
+                         {"node", c.point.node},
+                         {"x0", c.point.x0},
+                         {"y0", c.point.y0},
+                         {"max_abs_ux", c.max_abs_ux},
+                         {"max_abs_uy", c.max_abs_uy},
+                         {"max_displacement", c.max_displacement},
+                         {"final_ux", c.final_ux},
+                         {"final_uy", c.final_uy}};
+  return out;
+}
+
+SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {
+  const EnergyLedger& l = sim.ledger;
+  SeriesRecord r;
+  r.time = s.time;
+  r.kinetic = l.kinetic;
+  r.strain = l.strain;
+  r.contact = l.contact;
+  r.damping_dissipated = l.damping_dissipated;
+  r.friction_dissipated = l.friction_dissipated;
+  r.external_work = l.external_work;
+  r.max_displacement = max_free_displacement(sim.model);
+  r.active_contacts = sim.contact.active_pairs();
+  r.energy_balance_error = l.balance_error();
+  r.control_displacements = {s.table_acceleration, s.table_velocity, s.table_displacement};
+  for (size_t p = 0; p < s.control_ux.size(); ++p) {
+    r.control_displacements.push_back(s.control_ux[p]);
+    r.control_displacements.push_back(s.control_uy[p]);
+  }
+  return r;
+}
+
+int single_run(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
+  const auto wall0 = Clock::now();
+  const PulseCriteria crit;
+  const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
+  if (signal.kind() == BaseSignal::Kind::None)
+    throw DeckError(config.deck_path +
+                    ": load.base.signal = \"none\": `voussoir pulse` needs a base signal "
+                    "(windowed_sine, sine_pulse or file)");
+  const SettledState settled = settle(config, crit.settle, common.quiet);
+  if (!settled.settled)
+    throw RunError("the structure does not come to rest under gravity alone within " +
+                   std::to_string(crit.settle.settle_max_time) + " s");
+  const std::vector<ControlPoint> points = find_control_points(settled.sim.model);
+
+  const std::string out_path = opts.output.empty() ? config.output.file : opts.output;
+  const bool write_h5 = !out_path.empty();
+  RunWriter writer;
+  std::unique_ptr<std::ofstream> csv;
+  if (write_h5) {
+    writer.open(out_path, settled.sim.model, config.output.fields);
+    std::vector<std::string> cols = {"table_acceleration", "table_velocity", "table_displacement"};
+    for (const ControlPoint& p : points) {
+      cols.push_back(p.name + "_ux");
+      cols.push_back(p.name + "_uy");
+    }
+    writer.set_control_columns(cols);
+  }
+  if (!opts.series.empty()) {
+    csv = std::make_unique<std::ofstream>(opts.series);
+    if (!*csv) throw OutputError(opts.series + ": cannot write the series CSV");
+    *csv << "time,table_acceleration,table_velocity,table_displacement,kinetic,external_work,"
+            "energy_balance_error";
+    for (const ControlPoint& p : points) *csv << "," << p.name << "_ux," << p.name << "_uy";
+    *csv << "\n";
+    csv->precision(9);
+  }
+  // Series every 1/10 of the snapshot interval (as `run`); snapshots every output.every.
+  const double record_every = std::max(settled.sim.ctx.dt, config.output.every / 10.0);
+  double next_snapshot = 0.0;
+  auto recorder = [&](const Simulation& sim, const PulseSample& s) {
+    if (write_h5) {
+      writer.append_series(series_record(sim, s));
+      if (s.time >= next_snapshot - 0.5 * sim.ctx.dt) {
+        writer.write_snapshot(s.time, sim.model, {});
+        next_snapshot += config.output.every;
+      }
+    }
+    if (csv) {
+      *csv << s.time << "," << s.table_acceleration << "," << s.table_velocity << ","
+           << s.table_displacement << "," << sim.ledger.kinetic << "," << sim.ledger.external_work
+           << "," << sim.ledger.balance_error();
+      for (size_t p = 0; p < s.control_ux.size(); ++p)
+        *csv << "," << s.control_ux[p] << "," << s.control_uy[p];
+      *csv << "\n";
+    }
+  };
+  PulseResult r;
+  try {
+    r = run_pulse(settled, signal, config.load.lambda, points, crit,
+                  (write_h5 || csv) ? PulseRecorder(recorder) : PulseRecorder(), record_every);
+    if (write_h5) writer.close_complete();
+  } catch (const std::exception& e) {
+    if (write_h5) writer.close_incomplete(e.what());
+    throw;
+  }
+  r.amplitude_g = config.load.base.amplitude;
+  r.frequency = config.load.base.frequency;
+  const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
+
+  const double T = signal.duration();
+  std::printf("%s %s: %s (%s at t = %.3f s; signal %.3f s, peak %.4g m/s2)\n",
+              config.deck_path.c_str(), config.load.base.signal.c_str(),
+              r.collapsed ? "COLLAPSED" : "survived", r.reason.c_str(), r.decided_at, T,
+              signal.peak_acceleration());
+  std::printf(
+      "max kinetic energy %.4g J, max block displacement %.4g m, rotation %.4g rad, "
+      "residual %.4g m / %.4g rad\n",
+      r.max_kinetic_energy, r.max_displacement, r.max_rotation, r.residual_displacement,
+      r.residual_rotation);
+  std::printf(
+      "energy balance error %.2e (max %.2e of peak energy %.4g J); %lld steps, %.1f s "
+      "wall (settle %.1f s)\n",
+      r.energy_balance_error, r.max_energy_balance_error, r.peak_energy, r.steps, wall,
+      settled.wall_s);
+  for (const ControlSummary& c : r.control)
+    std::printf("  %-24s max |ux| %.4g m, |uy| %.4g m, final (%.4g, %.4g) m\n",
+                c.point.name.c_str(), c.max_abs_ux, c.max_abs_uy, c.final_ux, c.final_uy);
+
+  if (!common.json_path.empty()) {
+    nlohmann::json j = {{"collapsed", r.collapsed},
+                        {"reason", r.reason},
+                        {"decided_at", r.decided_at},
+                        {"signal",
+                         {{"kind", config.load.base.signal},
+                          {"amplitude_g", config.load.base.amplitude},
+                          {"frequency", config.load.base.frequency},
+                          {"cycles", config.load.base.cycles},
+                          {"duration", T},
+                          {"peak_acceleration", signal.peak_acceleration()},
+                          {"final_velocity", signal.velocity(T)},
+                          {"final_displacement", signal.displacement(T)}}},
+                        {"max_kinetic_energy", r.max_kinetic_energy},
+                        {"control_points", control_json(r.control)},
+                        {"max_displacement", r.max_displacement},
+                        {"max_rotation", r.max_rotation},
+                        {"residual_displacement", r.residual_displacement},
+                        {"residual_rotation", r.residual_rotation},
+                        {"energy_balance_error", r.energy_balance_error},
+                        {"max_energy_balance_error", r.max_energy_balance_error},
+                        {"peak_energy", r.peak_energy},
+                        {"hinges", hinges_json(r.hinges)},
+                        {"steps", r.steps},
+                        {"dt", settled.sim.ctx.dt},
+                        {"triangles", settled.sim.model.tris.size()},
+                        {"settle_wall_s", settled.wall_s},
+                        {"wall_s", wall},
+                        {"output", out_path}};
+    write_json(j, common.json_path);
+  }
+  return 0;
+}
+
+int curve_run(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
+  const auto wall0 = Clock::now();
+  if (opts.freqs.empty()) throw DeckError("pulse --curve needs --freqs F1,F2,... (Hz)");
+  for (double f : opts.freqs)
+    if (!(f > 0.0) || !std::isfinite(f))
+      throw DeckError("pulse --freqs: frequency " + std::to_string(f) + " Hz must be positive");
+  if (config.load.base.signal != "windowed_sine" && config.load.base.signal != "sine_pulse")
+    throw DeckError(config.deck_path + ": load.base.signal = \"" + config.load.base.signal +
+                    "\": pulse --curve needs an analytic pulse (windowed_sine or sine_pulse)");
+  if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
+    throw DeckError("pulse --tolerance " + std::to_string(opts.tolerance) + " must lie in (0, 1)");
+  const PulseCriteria crit;
+
+  double lambda_star = opts.lambda_star;
+  double capacity_wall = 0.0;
+  if (lambda_star < 0.0) {
+    if (!common.quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
+    const CapacityResult cap = find_capacity(config, crit.settle, opts.points, common.quiet);
+    lambda_star = cap.lambda_star;
+    capacity_wall = cap.wall_s;
+    if (!common.quiet)
+      std::fprintf(stderr, "lambda* = %.4f (%.1f s wall)\n", lambda_star, capacity_wall);
+  }
+  const double a0 = std::max(lambda_star, 0.01);
+
+  const SettledState settled = settle(config, crit.settle, common.quiet);
+  if (!settled.settled)
+    throw RunError("the structure does not come to rest under gravity alone within " +
+                   std::to_string(crit.settle.settle_max_time) + " s");
+
+  // Lowest frequencies (longest pulses) first for the dynamic schedule.
+  std::vector<double> freqs = opts.freqs;
+  std::vector<int> order(freqs.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return freqs[a] < freqs[b]; });
+  std::vector<CurvePoint> points(freqs.size());
+  std::vector<std::string> errors(freqs.size());
+  const int n = static_cast<int>(freqs.size());
+#pragma omp parallel for schedule(dynamic, 1) \
+    num_threads(std::max(1, std::min(n, omp_get_max_threads())))
+  for (int k = 0; k < n; ++k) {
+    const int i = order[k];
+    try {
+      points[i] = find_collapse_amplitude(settled, config.load.base, freqs[i], a0, opts.tolerance,
+                                          crit, common.quiet);
+    } catch (const std::exception& e) {
+      errors[i] = e.what();
+      points[i].frequency = freqs[i];
+    }
+    if (!common.quiet)
+      std::fprintf(stderr, "f = %.3f Hz: A = %.4f g (%d trials, %.1f s wall)%s%s\n", freqs[i],
+                   points[i].amplitude, points[i].trials, points[i].wall_s,
+                   errors[i].empty() ? "" : " error: ", errors[i].c_str());
+  }
+  const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
+
+  const std::string csv_path = opts.csv.empty() ? "curve.csv" : opts.csv;
+  {
+    std::ofstream csv(csv_path);
+    if (!csv) throw OutputError(csv_path + ": cannot write the curve CSV");
+    csv << "frequency,amplitude,lo,hi,bracketed,trials,wall_s,max_energy_balance_error,"
+           "lambda_star,error\n";
+    csv.precision(8);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const CurvePoint& p = points[i];
+      csv << p.frequency << "," << p.amplitude << "," << p.lo << "," << p.hi << ","
+          << (p.bracketed ? 1 : 0) << "," << p.trials << "," << p.wall_s << ","
+          << p.max_energy_balance_error << "," << lambda_star << ",\"" << errors[i] << "\"\n";
+    }
+  }
+  std::printf("lambda* = %.4f (tilting capacity, low-frequency asymptote)\n", lambda_star);
+  std::printf("%10s %12s %22s %7s %9s %10s\n", "f [Hz]", "A_c [g]", "bracket [g]", "trials",
+              "wall [s]", "max err");
+  for (const CurvePoint& p : points)
+    std::printf("%10.3f %12.5f   [%8.5f, %8.5f] %7d %9.1f %10.2e%s\n", p.frequency, p.amplitude,
+                p.lo, p.hi, p.trials, p.wall_s, p.max_energy_balance_error,
+                p.bracketed ? "" : "  (no collapse up to the cap)");
+  std::printf("curve %s; %.1f s wall in all\n", csv_path.c_str(), wall);
+  if (!opts.plot.empty()) {
+    const std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
+                            "/scripts/plot_curve '" + csv_path + "' -o '" + opts.plot + "'";
+    if (std::system(cmd.c_str()) != 0)
+      std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
+                   opts.plot.c_str());
+  }
+
+  if (!common.json_path.empty()) {
+    nlohmann::json curve = nlohmann::json::array();
+    for (size_t i = 0; i < points.size(); ++i) {
+      const CurvePoint& p = points[i];
+      nlohmann::json runs = nlohmann::json::array();
+      for (const PulseResult& r : p.runs)
+        runs.push_back({{"amplitude", r.amplitude_g},
+                        {"collapsed", r.collapsed},
+                        {"reason", r.reason},
+                        {"decided_at", r.decided_at},
+                        {"steps", r.steps},
+                        {"wall_s", r.wall_s},
+                        {"max_kinetic_energy", r.max_kinetic_energy},
+                        {"max_rotation", r.max_rotation},
+                        {"residual_rotation", r.residual_rotation},
+                        {"energy_balance_error", r.max_energy_balance_error}});
+      nlohmann::json e = {{"frequency", p.frequency},
+                          {"amplitude", p.amplitude},
+                          {"bracket", {p.lo, p.hi}},
+                          {"bracketed", p.bracketed},
+                          {"trials", p.trials},
+                          {"wall_s", p.wall_s},
+                          {"max_energy_balance_error", p.max_energy_balance_error},
+                          {"runs", runs}};
+      if (!errors[i].empty()) e["error"] = errors[i];
+      curve.push_back(e);
+    }
+    nlohmann::json j = {{"curve", curve},
+                        {"lambda_star", lambda_star},
+                        {"lambda_star_computed", opts.lambda_star < 0.0},
+                        {"capacity_wall_s", capacity_wall},
+                        {"signal", config.load.base.signal},
+                        {"cycles", config.load.base.cycles},
+                        {"tolerance", opts.tolerance},
+                        {"dt", settled.sim.ctx.dt},
+                        {"triangles", settled.sim.model.tris.size()},
+                        {"csv", csv_path},
+                        {"wall_s", wall}};
+    write_json(j, common.json_path);
+  }
+  for (const std::string& e : errors)
+    if (!e.empty()) return 1;
+  return 0;
+}
+
+}  // namespace
+
+int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
+  return opts.curve ? curve_run(config, common, opts) : single_run(config, common, opts);
+}
+
+}  // namespace voussoir

@@ -1,0 +1,310 @@
+// Base-excitation runs and the failure curve (criteria and decisions in pulse.hpp).
+
+#include "drivers/pulse.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "drivers/run.hpp"
+#include "drivers/setup.hpp"
+
+namespace voussoir {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+double max_free_speed(const Nodes& n) {
+  double v2 = 0.0;
+  for (Index i = 0; i < n.size(); ++i)
+    if (n.inv_mass[i] != 0.0) v2 = std::max(v2, n.vx[i] * n.vx[i] + n.vy[i] * n.vy[i]);
+  return std::sqrt(v2);
+}
+
+// Node of block b nearest to p.
+Index nearest_node(const Model& model, Index b, Vec2 p) {
+  const Block& blk = model.blocks[b];
+  const Nodes& n = model.nodes;
+  Index best = blk.first_node;
+  double d2 = std::numeric_limits<double>::infinity();
+  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+    const double d = (n.x0[i] - p.x) * (n.x0[i] - p.x) + (n.y0[i] - p.y) * (n.y0[i] - p.y);
+    if (d < d2) d2 = d, best = i;
+  }
+  return best;
+}
+
+// Hinge thresholds for the report, as in capacity: 1% of L_ref.
+constexpr double kHingeFraction = 0.01;
+
+}  // namespace
+
+std::vector<ControlPoint> find_control_points(const Model& model) {
+  std::vector<ControlPoint> out;
+  std::vector<Index> vous;
+  for (Index b = 0; b < static_cast<Index>(model.blocks.size()); ++b)
+    if (model.blocks[b].role == "voussoir" && !model.blocks[b].fixed) vous.push_back(b);
+  if (!vous.empty()) {
+    // Order from the left springing by reference centroid x.
+    std::vector<double> cx(model.blocks.size(), 0.0);
+    for (Index b : vous) {
+      const Block& blk = model.blocks[b];
+      double m = 0.0, sx = 0.0;
+      for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+        m += model.nodes.mass[i];
+        sx += model.nodes.mass[i] * model.nodes.x0[i];
+      }
+      cx[b] = m > 0.0 ? sx / m : 0.0;
+    }
+    std::sort(vous.begin(), vous.end(), [&](Index a, Index b) { return cx[a] < cx[b]; });
+    const int n = static_cast<int>(vous.size());
+    const int k = std::min(6, (n + 1) / 2);
+    struct Pick {
+      Index block;
+      std::string side;
+    };
+    std::vector<Pick> picks = {{vous[k - 1], "left"}};
+    if (n - k != k - 1) picks.push_back({vous[n - k], "right"});
+    for (const Pick& p : picks) {
+      // Extrados ends of the block's joints, springing side first (smaller joint position).
+      std::vector<const Joint*> joints;
+      for (const Joint& j : model.joints)
+        if (j.block_a == p.block || j.block_b == p.block) joints.push_back(&j);
+      std::sort(joints.begin(), joints.end(),
+                [](const Joint* a, const Joint* b) { return a->position_deg < b->position_deg; });
+      if (joints.size() != 2) continue;  // not a voussoir between two joints
+      // Left half: the springing side has the smaller angular position; right half: larger.
+      if (p.side == "right") std::swap(joints[0], joints[1]);
+      const char* names[2] = {"springing_side", "crown_side"};
+      for (int s = 0; s < 2; ++s) {
+        ControlPoint c;
+        c.name = p.side + std::to_string(k) + "_" + names[s];
+        c.block = p.block;
+        c.node = nearest_node(model, p.block, joints[s]->b);
+        c.x0 = model.nodes.x0[c.node];
+        c.y0 = model.nodes.y0[c.node];
+        out.push_back(c);
+      }
+    }
+    if (!out.empty()) return out;
+  }
+  for (Index b = 0; b < static_cast<Index>(model.blocks.size()) && out.size() < 8; ++b) {
+    const Block& blk = model.blocks[b];
+    if (blk.fixed || blk.node_count == 0) continue;
+    Index top = blk.first_node;
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i)
+      if (model.nodes.y0[i] > model.nodes.y0[top] ||
+          (model.nodes.y0[i] == model.nodes.y0[top] && model.nodes.x0[i] < model.nodes.x0[top]))
+        top = i;
+    out.push_back(ControlPoint{"block" + std::to_string(b) + "_top", b, top, model.nodes.x0[top],
+                               model.nodes.y0[top]});
+  }
+  return out;
+}
+
+PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, double lambda,
+                      const std::vector<ControlPoint>& points, const PulseCriteria& crit,
+                      const PulseRecorder& recorder, double record_every) {
+  const auto wall0 = Clock::now();
+  Simulation sim = settled.sim;  // deep copy
+  const double g = settled.gravity;
+  const double dt = sim.ctx.dt;
+  const long long step0 = sim.step;
+
+  // Optional lambda ramp before the signal (as in a capacity trial).
+  if (lambda != 0.0) {
+    const double t_ramp0 = sim.ctx.time;
+    while (sim.ctx.time - t_ramp0 < crit.settle.ramp_time) {
+      set_static_load(sim, g,
+                      lambda * std::min(1.0, (sim.ctx.time - t_ramp0) / crit.settle.ramp_time));
+      advance(sim);
+    }
+    check_finite(sim);
+  }
+
+  const double t0 = sim.ctx.time;
+  const long long every = std::max(1LL, std::llround(crit.sample_time / dt));
+  const long long rec_every = std::max(1LL, std::llround(record_every / dt));
+  const double duration = signal.duration();
+  const double v_rest = crit.rest_speed * std::sqrt(std::max(g, 1e-12) * settled.l_ref);
+  const double d_fall = crit.fall_displacement * settled.l_ref;
+  const std::vector<BlockMotion> base = block_motions(sim.model);
+  std::vector<double> cx0(points.size()), cy0(points.size());
+  for (size_t p = 0; p < points.size(); ++p) {
+    cx0[p] = sim.model.nodes.x[points[p].node];
+    cy0[p] = sim.model.nodes.y[points[p].node];
+  }
+
+  PulseResult r;
+  r.signal_duration = duration;
+  r.control.resize(points.size());
+  for (size_t p = 0; p < points.size(); ++p) r.control[p].point = points[p];
+  PulseSample sample;
+  sample.control_ux.resize(points.size());
+  sample.control_uy.resize(points.size());
+  auto update_controls = [&](const Simulation& s) {
+    for (size_t p = 0; p < points.size(); ++p) {
+      const double ux = s.model.nodes.x[points[p].node] - cx0[p];
+      const double uy = s.model.nodes.y[points[p].node] - cy0[p];
+      ControlSummary& c = r.control[p];
+      c.max_abs_ux = std::max(c.max_abs_ux, std::abs(ux));
+      c.max_abs_uy = std::max(c.max_abs_uy, std::abs(uy));
+      c.max_displacement = std::max(c.max_displacement, std::hypot(ux, uy));
+      c.final_ux = ux;
+      c.final_uy = uy;
+      sample.control_ux[p] = ux;
+      sample.control_uy[p] = uy;
+    }
+  };
+  auto record = [&](const Simulation& s) {
+    if (!recorder) return;
+    const double t = s.ctx.time - t0;
+    sample.time = t;
+    sample.table_acceleration = signal.acceleration(t);
+    sample.table_velocity = signal.velocity(t);
+    sample.table_displacement = signal.displacement(t);
+    update_controls(s);
+    recorder(s, sample);
+  };
+
+  record(sim);
+  std::vector<double> measure;  // motion measure after the signal (timeout decision)
+  double rest_since = -1.0;
+  bool decided = false;
+  const double body_x0 = lambda * g;
+  while (!decided) {
+    const double t = sim.ctx.time - t0;
+    sim.ctx.body_ax = body_x0 - signal.acceleration(t);
+    sim.ctx.body_ay = -g;
+    advance(sim);
+    r.max_kinetic_energy = std::max(r.max_kinetic_energy, sim.ledger.kinetic);
+    const long long k = sim.step - step0;
+    if (k % rec_every == 0) record(sim);
+    if (k % every != 0) continue;
+    check_finite(sim);
+    const double ts = sim.ctx.time - t0;
+    r.max_energy_balance_error = std::max(r.max_energy_balance_error, sim.ledger.balance_error());
+    update_controls(sim);
+    const std::vector<BlockMotion> now = block_motions(sim.model);
+    double dmax = 0.0, rmax = 0.0;
+    for (size_t b = 0; b < now.size(); ++b) {
+      if (sim.model.blocks[b].fixed) continue;
+      dmax = std::max(dmax, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
+      rmax = std::max(rmax, std::abs(now[b].rotation - base[b].rotation));
+    }
+    r.max_displacement = std::max(r.max_displacement, dmax);
+    r.max_rotation = std::max(r.max_rotation, rmax);
+    r.residual_displacement = dmax;
+    r.residual_rotation = rmax;
+    r.decided_at = ts;
+    if (dmax > d_fall || rmax > crit.fall_rotation) {
+      r.collapsed = true;
+      r.reason = "fall";
+      break;
+    }
+    if (ts < duration) continue;
+    measure.push_back(std::max(dmax / d_fall, rmax / crit.fall_rotation));
+    if (max_free_speed(sim.model.nodes) < v_rest) {
+      if (rest_since < 0.0) rest_since = ts;
+      if (ts - rest_since >= crit.hold_time) {
+        r.reason = "rest";
+        decided = true;
+      }
+    } else {
+      rest_since = -1.0;
+    }
+    if (!decided && ts >= duration + crit.free_time) {
+      const size_t cut = measure.size() * 2 / 3;
+      const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
+      r.collapsed = measure.back() > 1.1 * earlier;
+      r.reason = "timeout";
+      decided = true;
+    }
+  }
+  record(sim);
+  r.steps = sim.step - step0;
+  r.energy_balance_error = sim.ledger.balance_error();
+  r.max_energy_balance_error = std::max(r.max_energy_balance_error, r.energy_balance_error);
+  r.peak_energy = sim.ledger.max_energy;
+  const double tol = kHingeFraction * settled.l_ref;
+  r.hinges = find_hinges(sim.model, tol, tol);
+  r.wall_s = seconds_since(wall0);
+  return r;
+}
+
+CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
+                                   double frequency, double a0, double tolerance,
+                                   const PulseCriteria& crit, bool quiet) {
+  const auto wall0 = Clock::now();
+  CurvePoint cp;
+  cp.frequency = frequency;
+  const std::vector<ControlPoint> points = find_control_points(settled.sim.model);
+  auto trial = [&](double a) {
+    const BaseSignal signal = make_base_signal(base, a, frequency, settled.gravity);
+    PulseResult r = run_pulse(settled, signal, 0.0, points, crit);
+    r.amplitude_g = a;
+    r.frequency = frequency;
+    r.control.clear();  // not needed per trial
+    cp.max_energy_balance_error = std::max(cp.max_energy_balance_error, r.max_energy_balance_error);
+    if (!quiet)
+      std::fprintf(stderr,
+                   "  f = %6.3f Hz  A = %.5f g  %-9s (%s at t = %.3f s, %lld steps, %.1f s wall)\n",
+                   frequency, a, r.collapsed ? "collapsed" : "survived", r.reason.c_str(),
+                   r.decided_at, r.steps, r.wall_s);
+    cp.runs.push_back(r);
+    return r.collapsed;
+  };
+
+  // Bracket: up from a0 until a collapse, or down from a0 until a survival.
+  double lo = 0.0, hi = 0.0;
+  bool have_hi = false, have_lo = false;
+  double a = a0;
+  if (trial(a)) {
+    hi = a, have_hi = true;
+    while (!have_lo && a > 1e-3) {
+      a /= kBracketGrowth;
+      if (trial(a)) {
+        hi = a;
+      } else {
+        lo = a, have_lo = true;
+      }
+    }
+  } else {
+    lo = a, have_lo = true;
+    while (!have_hi && a * kBracketGrowth <= kMaxAmplitude) {
+      a *= kBracketGrowth;
+      if (trial(a)) {
+        hi = a, have_hi = true;
+      } else {
+        lo = a;
+      }
+    }
+  }
+  cp.bracketed = have_hi;
+  if (have_hi) {
+    while (hi - lo > tolerance * hi) {
+      const double mid = 0.5 * (lo + hi);
+      if (trial(mid)) {
+        hi = mid;
+      } else {
+        lo = mid;
+      }
+    }
+  }
+  cp.lo = lo;
+  cp.hi = have_hi ? hi : lo;
+  cp.amplitude = cp.hi;
+  cp.trials = static_cast<int>(cp.runs.size());
+  cp.wall_s = seconds_since(wall0);
+  return cp;
+}
+
+}  // namespace voussoir
