@@ -173,15 +173,16 @@ inline PairResult ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, c
   const double cyh = std::max({y[c[0]], y[c[1]], y[c[2]]});
   const double dyl = std::min({y[d[0]], y[d[1]], y[d[2]]});
   const double dyh = std::max({y[d[0]], y[d[1]], y[d[2]]});
-  PairForce f;
-  if (cxl < dxh && dxl < cxh && cyl < dyh && dyl < cyh) {
-    f = triangle_pair_force(
-        {Vec2{x[c[0]], y[c[0]]}, Vec2{x[c[1]], y[c[1]]}, Vec2{x[c[2]], y[c[2]]}},
-        {Vec2{x[d[0]], y[d[0]]}, Vec2{x[d[1]], y[d[1]]}, Vec2{x[d[2]], y[d[2]]}},
-        penalty * thickness);
-  }
-  if (!(f.area > 0.0)) {
+  if (!(cxl < dxh && dxl < cxh && cyl < dyh && dyl < cyh)) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
+    return r;
+  }
+  const PairForce f =
+      triangle_pair_force({Vec2{x[c[0]], y[c[0]]}, Vec2{x[c[1]], y[c[1]]}, Vec2{x[c[2]], y[c[2]]}},
+                          {Vec2{x[d[0]], y[d[0]]}, Vec2{x[d[1]], y[d[1]]}, Vec2{x[d[2]], y[d[2]]}},
+                          penalty * thickness);
+  if (!(f.area > 0.0)) {
+    if constexpr (kFriction) sx[p] = sy[p] = 0.0;
     return r;
   }
   r.active = true;

@@ -205,7 +205,6 @@ inline Field field_over(const Bary& T, double gx, double gy, const Poly& P, cons
 
 PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec2, 3>& t,
                               double penalty) {
-  PairForce out;
   // Local coordinates about c's first vertex.
   const double ox = c[0].x, oy = c[0].y;
   double cx[3], cy[3], tx[3], ty[3];
@@ -215,8 +214,9 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
     tx[k] = t[k].x - ox;
     ty[k] = t[k].y - oy;
   }
-  const Edges ec = edge_functions(cx, cy), et = edge_functions(tx, ty);
-  if (!(ec.twice_area > 0.0) || !(et.twice_area > 0.0)) return out;
+  const Edges ec = edge_functions(cx, cy);
+  const double t_twice_area = (tx[1] - tx[0]) * (ty[2] - ty[0]) - (ty[1] - ty[0]) * (tx[2] - tx[0]);
+  if (!(ec.twice_area > 0.0) || !(t_twice_area > 0.0)) return {};
 
   // Overlap P = t clipped by the three edges of c (no division before we know it is there).
   Poly p0, p1;
@@ -227,15 +227,17 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
     p0.on_c[k] = 0;
   }
   clip(p0, ec.e[0], p1);
-  if (p1.n < 3) return out;
+  if (p1.n < 3) return {};
   clip(p1, ec.e[1], p0);
-  if (p0.n < 3) return out;
+  if (p0.n < 3) return {};
   clip(p0, ec.e[2], p1);
   const Poly& P = p1;
-  if (P.n < 3) return out;
+  if (P.n < 3) return {};
   const Moments mp = moments(P);
-  if (!(mp.area > kMinOverlapFraction * 0.5 * std::min(ec.twice_area, et.twice_area))) return out;
+  if (!(mp.area > kMinOverlapFraction * 0.5 * std::min(ec.twice_area, t_twice_area))) return {};
 
+  PairForce out;
+  const Edges et = edge_functions(tx, ty);
   const Bary bc = barycentric(ec), bt = barycentric(et);
   const Field fc =
       field_over(bc, (cx[0] + cx[1] + cx[2]) / 3.0, (cy[0] + cy[1] + cy[2]) / 3.0, P, mp, 0);

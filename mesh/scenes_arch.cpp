@@ -21,9 +21,11 @@
 // and each joint face is one column shared by the two voussoirs that meet there.
 //
 // Supports:
-//   circular_arch / basket_arch: a fixed abutment under each springing joint, the quadrilateral
-//     I, (x_I, y_b), (x_E, y_b), E (I, E: intrados and extrados springing points,
-//     y_b = min(y_I, y_E) - t): its top face is exactly the springing joint.
+//   circular_arch / basket_arch: a fixed abutment under each springing joint: the t-deep
+//     rectangle I, I + t D, E + t D, E (I, E: intrados and extrados springing points, D the
+//     centreline direction beyond the springing, normal to the joint), so its top face is
+//     exactly the springing joint and every corner is square (vertical sides would leave a
+//     90 - g degree corner at E, too sharp to mesh well for small embraces).
 //   buttressed_arch: a free buttress on each side (SPEC: inner face vertical through I, top
 //     along the joint to E, then horizontal out to x_I + B, outer face down to the ground line
 //     y = -H1), monolithic or in horizontal courses of height `courses` from the ground up (the
@@ -269,8 +271,15 @@ void add_abutments(const Config& config, Scene& scene, const std::vector<Vec2>& 
   const Index nv = static_cast<Index>(scene.blocks.size());
   const std::size_t n = right.size() - 1;
   const Vec2 ip = right.front(), ep = right.back();
-  const double yb = std::min(ip.y, ep.y) - t;
-  const Vec2 ib{ip.x, yb}, eb{ep.x, yb};
+  // A t-deep rectangle hung under the joint: its sides continue the centreline's direction
+  // beyond the springing, D = the joint direction (I -> E) turned clockwise by 90 degrees.
+  const Vec2 f = (1.0 / distance(ip, ep)) * (ep - ip);
+  const Vec2 down{f.y, -f.x};
+  const Vec2 ib = ip + t * down, eb = ep + t * down;
+  if (!(std::min(ib.x, eb.x) > 0.0))
+    geometry_error(config, "model.embrace", config.model.embrace,
+                   "the springings are too close together for their abutments (the arch closes "
+                   "on itself); use a smaller embrace");
 
   BlockSpec r;
   r.role = "abutment";

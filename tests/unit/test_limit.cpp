@@ -239,6 +239,22 @@ TEST(LimitBlock, FloatingBlockHasNoEquilibrium) {
   EXPECT_FALSE(limit_analysis(m, 0.6, 9.81, true).admissible);
 }
 
+TEST(LimitBlock, WedgedBlockNeverCollapses) {
+  // A block between two fixed walls on a fixed ground: every horizontal load is carried.
+  Model m;
+  add_rectangle(m, -1.0, -0.5, 3.0, 0.5, 3, 1, true);  // ground
+  add_rectangle(m, -1.0, 0.0, 1.0, 1.0, 1, 1, true);   // left wall
+  add_rectangle(m, 1.0, 0.0, 1.0, 1.0, 1, 1, true);    // right wall
+  add_rectangle(m, 0.0, 0.0, 1.0, 1.0, 2, 2, false);   // the block, touching all three
+  finalize_model(m);
+  EXPECT_EQ(find_interfaces(m).size(), 5u);  // 2 ground-wall, 3 around the block
+  const LimitResult r = limit_analysis(m, 0.6, 9.81, false);
+  EXPECT_EQ(r.status, "unbounded");
+  EXPECT_TRUE(std::isnan(r.lambda_la));
+  EXPECT_TRUE(r.admissible);
+  EXPECT_EQ(r.interfaces.size(), 3u);  // fixed-fixed interfaces are left out of the LP
+}
+
 // ---------------------------------------------------------------- published arch values
 
 TEST(LimitArch, CircularArchesMatchPublishedLimitAnalysis) {
