@@ -64,6 +64,11 @@ int main(int argc, char** argv) {
                        "trial lambdas per bisection round, run in parallel (default 2)")
       ->check(CLI::Range(1, 64));
 
+  capacity->add_flag("--no-seed", cap_opts.no_seed,
+                     "start from the generic bracket, not from limit analysis");
+  capacity->add_option("--resume", cap_opts.resume,
+                       "journal of finished trials: created, or resumed after a kill");
+
   voussoir::LimitCommandOptions limit_opts;
   CLI::App* limit =
       app.add_subcommand("limit", "rigid-block limit analysis: lambda_la and its mechanism (LP)");

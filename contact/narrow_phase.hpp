@@ -54,9 +54,10 @@
 // the corner touches of neighbouring triangles along a joint (in the settled 1388-triangle
 // arch: areas 1e-27 to 1e-20 m2, forces ~1e-6 N against ~1e3 N through the joint; 86 of
 // the 158 overlapping pairs); skipping them right after the clip cuts the instructions of the
-// contact stage there by 27% (callgrind). A
-// resting face-to-face strip has a relative area d/h = p / (6 Ep) (p: contact pressure), so
-// the cut-off reaches real contacts only below p ~ 1 Pa at the default Ep (a sheet of paper).
+// contact stage there by 27% (callgrind). A resting face-to-face strip of depth d has
+// p = Ep (3/h_c + 3/h_t) d ~ 6 Ep d / h (p: contact pressure) and a relative area
+// L d / (L h / 2) = p / (3 Ep), so the cut-off reaches real contacts only below
+// p = 3e-13 Ep, 0.3 Pa at the default Ep of a 40 GPa stone (a sheet of paper weighs ~1 Pa).
 //
 // Units: Ep in Pa, multiplied by the out-of-plane thickness [m] before calling (the kernel
 // takes `penalty` = Ep x thickness [N/m2]); forces N, energy J, area m2.

@@ -16,8 +16,10 @@
 //                  Bohman window w(x) = (1 - |x|) cos(pi |x|) + sin(pi |x|) / pi, |x| <= 1.
 //                  Table velocity at T is zero for any integer number of cycles: w is even
 //                  about t = T/2 and sin(2 pi f (T - t)) = -sin(2 pi f t), so a_g is odd about
-//                  T/2 and its integral over [0, T] vanishes. (The displacement at T,
-//                  -int t a_g dt, does not: the table ends displaced, at rest.)
+//                  T/2 and its integral over [0, T] vanishes. The displacement at T,
+//                  -int t a_g dt, vanishes too for an odd number of cycles >= 3 (the Fourier
+//                  transform of the Bohman window has double zeros there), not otherwise
+//                  (1 cycle, even cycles): then the table ends displaced, at rest.
 //   sine_pulse     a_g(t) = A sin(2 pi f t) for 0 <= t <= 1/f (one full cycle), 0 after;
 //                  v(t) = A / (2 pi f) (1 - cos 2 pi f t): v(1/f) = 0, d(1/f) = A / (2 pi f^2).
 //   file           two columns (time [s], acceleration [g or m/s2]); linear interpolation

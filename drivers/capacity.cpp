@@ -6,10 +6,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "limit/limit_analysis.hpp"
 
 namespace voussoir {
 namespace {
@@ -161,31 +164,171 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
 
 namespace {
 
-// Runs the given lambdas (in parallel when cores allow) and returns results in input order.
-std::vector<TrialResult> run_round(const SettledState& s, const std::vector<double>& lambdas,
-                                   const TrialCriteria& crit) {
-  std::vector<TrialResult> out(lambdas.size());
-  const int n = static_cast<int>(lambdas.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(std::min(n, omp_get_max_threads()))
-  for (int i = 0; i < n; ++i) out[i] = run_trial(s, lambdas[i], crit);
-  return out;
+void report(const TrialResult& r, bool quiet, bool resumed) {
+  if (quiet) return;
+  std::fprintf(stderr, "  lambda = %.5f  %-9s (%s, %.3f s simulated, %lld steps, %.2f s wall)%s\n",
+               r.lambda, r.collapsed ? "collapsed" : "stable", r.reason.c_str(), r.sim_time,
+               r.steps, r.wall_s, resumed ? " [journal]" : "");
 }
 
-void report(const TrialResult& r, bool quiet) {
-  if (quiet) return;
-  std::fprintf(stderr, "  lambda = %.5f  %-9s (%s, %.3f s simulated, %lld steps, %.2f s wall)\n",
-               r.lambda, r.collapsed ? "collapsed" : "stable", r.reason.c_str(), r.sim_time,
-               r.steps, r.wall_s);
+// FNV-1a over bytes: the journal's fingerprint of a settled state and the trial criteria.
+struct Fingerprint {
+  std::uint64_t h = 1469598103934665603ull;
+  void add(const void* data, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  }
+  void add(double v) { add(&v, sizeof v); }
+};
+
+std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
+  Fingerprint f;
+  const Nodes& n = s.sim.model.nodes;
+  f.add(n.x.data(), n.x.size() * sizeof(double));
+  f.add(n.y.data(), n.y.size() * sizeof(double));
+  f.add(n.vx.data(), n.vx.size() * sizeof(double));
+  f.add(n.vy.data(), n.vy.size() * sizeof(double));
+  for (double v : {s.sim.ctx.dt, s.sim.ctx.eta, s.gravity, c.ramp_time, c.collapse_displacement,
+                   c.collapse_rotation, c.rest_speed, c.hold_time, c.max_time})
+    f.add(v);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(f.h));
+  return buf;
 }
+
+nlohmann::json trial_json(const TrialResult& r) {
+  nlohmann::json hinges = nlohmann::json::array();
+  for (const Hinge& h : r.hinges)
+    hinges.push_back({h.joint, h.block_a, h.block_b, h.kind, h.side, h.position_deg, h.x, h.y,
+                      h.opening, h.slip});
+  return {{"lambda", r.lambda},     {"collapsed", r.collapsed},
+          {"reason", r.reason},     {"sim_time", r.sim_time},
+          {"steps", r.steps},       {"wall_s", r.wall_s},
+          {"max_displacement", r.max_displacement},
+          {"max_rotation", r.max_rotation},
+          {"energy_balance_error", r.energy_balance_error},
+          {"hinges", hinges}};
+}
+
+TrialResult trial_from_json(const nlohmann::json& j) {
+  TrialResult r;
+  r.lambda = j.at("lambda");
+  r.collapsed = j.at("collapsed");
+  r.reason = j.at("reason");
+  r.sim_time = j.at("sim_time");
+  r.steps = j.at("steps");
+  r.wall_s = j.at("wall_s");
+  r.max_displacement = j.at("max_displacement");
+  r.max_rotation = j.at("max_rotation");
+  r.energy_balance_error = j.at("energy_balance_error");
+  // NaN is written as null (a joint without an angular position).
+  auto num = [](const nlohmann::json& v) {
+    return v.is_null() ? std::numeric_limits<double>::quiet_NaN() : v.get<double>();
+  };
+  for (const auto& h : j.at("hinges"))
+    r.hinges.push_back(Hinge{h[0], h[1], h[2], h[3], h[4], num(h[5]), num(h[6]), num(h[7]),
+                             num(h[8]), num(h[9])});
+  return r;
+}
+
+// Finished trials on disk, one JSON object a line after a header line with the fingerprint.
+// Lambdas are written with 17 significant digits, so a resumed search that recomputes the
+// same lambdas finds them bit for bit. A journal of another state is refused, never mixed.
+class Journal {
+ public:
+  Journal(const std::string& path, const std::string& print) : path_(path) {
+    if (path_.empty()) return;
+    std::ifstream in(path_);
+    std::string line;
+    if (in && std::getline(in, line)) {
+      const auto head = nlohmann::json::parse(line, nullptr, false);
+      if (head.is_discarded() || head.value("fingerprint", "") != print)
+        throw RunError("journal " + path_ +
+                       " belongs to another deck or settings (fingerprint differs): remove it "
+                       "or give another --resume file");
+      while (std::getline(in, line)) {
+        const auto j = nlohmann::json::parse(line, nullptr, false);
+        if (j.is_discarded()) break;  // a line cut by the kill: the trial is run again
+        const TrialResult r = trial_from_json(j);
+        done_.emplace_back(r);
+      }
+      in.close();
+      // Rewrite without a possibly cut last line.
+      std::ofstream out(path_, std::ios::trunc);
+      out << nlohmann::json{{"fingerprint", print}}.dump() << '\n';
+      for (const TrialResult& r : done_) out << trial_json(r).dump() << '\n';
+    } else {
+      std::ofstream out(path_, std::ios::trunc);
+      if (!out) throw RunError("cannot write the journal " + path_);
+      out << nlohmann::json{{"fingerprint", print}}.dump() << '\n';
+    }
+  }
+  const TrialResult* find(double lambda) const {
+    for (const TrialResult& r : done_)
+      if (r.lambda == lambda) return &r;
+    return nullptr;
+  }
+  void append(const TrialResult& r) {
+    if (path_.empty()) return;
+    std::ofstream out(path_, std::ios::app);
+    out << trial_json(r).dump() << '\n';
+    out.flush();
+  }
+
+ private:
+  std::string path_;
+  std::vector<TrialResult> done_;
+};
 
 }  // namespace
 
+int unseeded_trial_count(double lambda_star, double lambda_min, double tolerance, int points) {
+  constexpr double kFirstGuess = 0.125, kCap = 8.0;
+  int trials = 0;
+  double lo = lambda_min, hi = 0.0;
+  bool have_hi = false;
+  double next = std::max(kFirstGuess, 2.0 * lo);
+  while (!have_hi && next <= kCap) {
+    for (int i = 0; i < points && next <= kCap; ++i, next *= 2.0) {
+      ++trials;
+      if (!have_hi && next > lambda_star) {
+        hi = next;
+        have_hi = true;
+      } else if (!have_hi) {
+        lo = next;
+      }
+    }
+  }
+  if (!have_hi) return trials;
+  while (hi - lo > tolerance * hi) {
+    double new_lo = lo, new_hi = hi;
+    for (int i = 1; i <= points; ++i) {
+      const double l = lo + (hi - lo) * i / (points + 1);
+      ++trials;
+      if (l > lambda_star) new_hi = std::min(new_hi, l);
+      else new_lo = std::max(new_lo, l);
+    }
+    lo = new_lo;
+    hi = new_hi;
+  }
+  return trials;
+}
+
 CapacityResult find_capacity(const Config& config, const TrialCriteria& crit, int points,
                              bool quiet) {
+  CapacitySearch search;
+  search.points = points;
+  search.quiet = quiet;
+  return find_capacity(config, crit, search);
+}
+
+CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
+                             const CapacitySearch& search) {
   const auto t0 = Clock::now();
+  const bool quiet = search.quiet;
+  const int points = std::max(1, search.points);
   CapacityResult res;
   res.tolerance = config.capacity.tolerance;
-  points = std::max(1, points);
   const SettledState settled = settle(config, crit, quiet);
   res.triangles = settled.sim.model.tris.size();
   res.dt = settled.sim.ctx.dt;
@@ -193,32 +336,113 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit, in
     throw RunError("the structure does not come to rest under gravity alone within " +
                    std::to_string(crit.settle_max_time) +
                    " s: it has no gravity capacity (lambda* = 0) or needs a longer settle");
+  Journal journal(search.journal, fingerprint(settled, crit));
 
-  double lo = config.capacity.lambda_min, hi = config.capacity.lambda_max;
-  const TrialResult* hinge_source = nullptr;
-  auto record = [&](const std::vector<TrialResult>& round) {
-    for (const TrialResult& r : round) {
-      report(r, quiet);
-      res.trials.push_back(r);
+  // Runs the lambdas not in the journal (in parallel when cores allow); returns all results
+  // in input order.
+  auto evaluate = [&](const std::vector<double>& lambdas) {
+    std::vector<TrialResult> out(lambdas.size());
+    std::vector<int> todo;
+    for (size_t i = 0; i < lambdas.size(); ++i) {
+      if (const TrialResult* r = journal.find(lambdas[i])) {
+        out[i] = *r;
+        ++res.resumed_trials;
+      } else {
+        todo.push_back(static_cast<int>(i));
+      }
     }
+    const int n = static_cast<int>(todo.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, std::min(n, omp_get_max_threads())))
+    for (int k = 0; k < n; ++k) {
+      const int i = todo[k];
+      out[i] = run_trial(settled, lambdas[i], crit);
+#pragma omp critical(voussoir_journal)
+      journal.append(out[i]);
+    }
+    for (size_t i = 0; i < out.size(); ++i) {
+      const bool resumed = std::find(todo.begin(), todo.end(), int(i)) == todo.end();
+      report(out[i], quiet, resumed);
+      res.trials.push_back(out[i]);
+    }
+    return out;
   };
 
-  // Bracket: a given upper bound is checked; otherwise lambdas grow geometrically from
-  // 0.125 until one collapses (cap 8: beyond that the structure is not a masonry mechanism).
-  constexpr double kFirstGuess = 0.125, kCap = 8.0;
+  double lo = config.capacity.lambda_min, hi = config.capacity.lambda_max;
   bool have_hi = false;
+  constexpr double kFirstGuess = 0.125, kCap = 8.0;
+
   if (hi > lo) {
-    const auto round = run_round(settled, {hi}, crit);
-    record(round);
+    // The deck's bracket: its upper end is checked (the lower is trusted, 0 by default).
+    const auto round = evaluate({hi});
     have_hi = round[0].collapsed;
     if (!have_hi) lo = hi;
+  } else if (search.seed_from_limit) {
+    const LimitResult la =
+        limit_analysis(settled.sim.model, config.contact.friction, settled.gravity, false);
+    res.seed.status = la.status;
+    if (la.status == "optimal" && la.lambda_la > lo) {
+      res.seed.used = true;
+      res.seed.lambda_la = la.lambda_la;
+      double s_lo = std::max(lo, kSeedLow * la.lambda_la), s_hi = kSeedHigh * la.lambda_la;
+      if (!quiet)
+        std::fprintf(stderr, "limit analysis: lambda_la = %.5f, seeded bracket [%.5f, %.5f]\n",
+                     la.lambda_la, s_lo, s_hi);
+      const auto round = evaluate({s_lo, s_hi});
+      if (!round[0].collapsed) lo = s_lo;
+      if (round[1].collapsed) {
+        hi = s_hi;
+        have_hi = true;
+      } else {
+        lo = s_hi;
+      }
+      res.seed.held = !round[0].collapsed && round[1].collapsed;
+      // Widen a contradicted seed geometrically: down when its low end collapsed, up when its
+      // high end stood.
+      if (round[0].collapsed) {
+        hi = s_lo;
+        have_hi = true;
+        double down = s_lo;
+        bool found = false;
+        while (!found && down > 1e-3) {
+          ++res.seed.widenings;
+          down *= 0.7;
+          if (!quiet)
+            std::fprintf(stderr, "seed contradicted (collapse at %.5f): widening down\n", hi);
+          const auto r = evaluate({down});
+          if (r[0].collapsed) hi = down;
+          else {
+            lo = down;
+            found = true;
+          }
+        }
+        if (!found) lo = 0.0;
+      }
+      if (!have_hi) {
+        if (!quiet)
+          std::fprintf(stderr, "seed contradicted (stable at %.5f): widening up\n", s_hi);
+        double up = s_hi;
+        while (!have_hi && up < kCap) {
+          ++res.seed.widenings;
+          up *= 1.3;
+          const auto r = evaluate({up});
+          if (r[0].collapsed) {
+            hi = up;
+            have_hi = true;
+          } else {
+            lo = up;
+          }
+        }
+      }
+    }
   }
+
+  // Unseeded bracket: lambdas grow geometrically from 0.125 until one collapses (cap 8: beyond
+  // that the structure is not a masonry mechanism).
   double next = std::max(kFirstGuess, 2.0 * lo);
   while (!have_hi && next <= kCap) {
     std::vector<double> lambdas;
     for (int i = 0; i < points && next <= kCap; ++i, next *= 2.0) lambdas.push_back(next);
-    const auto round = run_round(settled, lambdas, crit);
-    record(round);
+    const auto round = evaluate(lambdas);
     for (const TrialResult& r : round) {
       if (r.collapsed) {
         hi = r.lambda;
@@ -230,22 +454,18 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit, in
   }
   res.bracketed = have_hi;
   if (!have_hi) {
-    res.lo = lo;
-    res.hi = lo;
-    res.lambda_star = lo;
+    res.lo = res.hi = res.lambda_star = lo;
     res.wall_s = seconds_since(t0);
     return res;
   }
 
-  // k-section: `points` interior lambdas per round.
+  // k-section: `points` interior lambdas per round. The lowest collapse is the new upper bound
+  // and the highest stable trial below it the new lower bound (a stable trial above a collapsed
+  // one, a non-monotone response near the threshold, is ignored).
   while (hi - lo > res.tolerance * hi) {
     std::vector<double> lambdas;
     for (int i = 1; i <= points; ++i) lambdas.push_back(lo + (hi - lo) * i / (points + 1));
-    const auto round = run_round(settled, lambdas, crit);
-    record(round);
-    // The lowest collapse is the new upper bound and the highest stable trial below it the
-    // new lower bound (a stable trial above a collapsed one, a non-monotone response near the
-    // threshold, is ignored).
+    const auto round = evaluate(lambdas);
     for (const TrialResult& r : round)
       if (r.collapsed) hi = std::min(hi, r.lambda);
     for (const TrialResult& r : round)
@@ -253,11 +473,13 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit, in
     if (!quiet) std::fprintf(stderr, "bracket [%.5f, %.5f]\n", lo, hi);
   }
   for (const TrialResult& r : res.trials)
-    if (r.collapsed && r.lambda == hi) hinge_source = &r;
-  if (hinge_source) res.hinges = hinge_source->hinges;
+    if (r.collapsed && r.lambda == hi) res.hinges = r.hinges;
   res.lo = lo;
   res.hi = hi;
   res.lambda_star = 0.5 * (lo + hi);
+  if (res.seed.used)
+    res.seed.unseeded_trials =
+        unseeded_trial_count(res.lambda_star, config.capacity.lambda_min, res.tolerance, points);
   res.wall_s = seconds_since(t0);
   return res;
 }

@@ -72,6 +72,32 @@ SettledState settle(const Config& config, const TrialCriteria& criteria, bool qu
 // One trial from a copy of the settled state.
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria);
 
+// How the search starts and what it remembers.
+struct CapacitySearch {
+  int points = 2;                      // trial lambdas per round
+  // Seed the bracket from rigid-block limit analysis (limit/limit_analysis.hpp) on the same
+  // blocks: [kSeedLow, kSeedHigh] x lambda_la, both ends confirmed by FDEM trials, widened
+  // geometrically when a trial contradicts the seed. Ignored when the deck gives
+  // capacity.lambda_max.
+  bool seed_from_limit = true;
+  // Journal of finished trials (JSON lines); trials found there are not run again, so a killed
+  // capacity run resumes where it stopped. Empty = none.
+  std::string journal;
+  bool quiet = false;
+};
+
+inline constexpr double kSeedLow = 0.92;   // FDEM lambda* lies a few % below the rigid LA one
+inline constexpr double kSeedHigh = 1.02;  // (deformable blocks, non-associative friction)
+
+struct SeedReport {
+  bool used = false;
+  double lambda_la = 0.0;
+  std::string status;                  // limit analysis status
+  bool held = false;                   // both seeded ends confirmed by the first trials
+  int widenings = 0;                   // rounds spent widening a contradicted bracket
+  int unseeded_trials = 0;             // trials the unseeded search would run to this bracket
+};
+
 struct CapacityResult {
   double lambda_star = 0.0;
   double lo = 0.0, hi = 0.0;
@@ -82,10 +108,19 @@ struct CapacityResult {
   Index triangles = 0;
   double dt = 0.0;                     // [s]
   bool bracketed = false;              // false when no collapse was found up to the cap
+  SeedReport seed;
+  int resumed_trials = 0;              // trials taken from the journal
 };
 
 // Bisection for lambda*; progress lines on stderr unless quiet.
+CapacityResult find_capacity(const Config& config, const TrialCriteria& criteria,
+                             const CapacitySearch& search);
+// Same with default search options except `points` and `quiet`.
 CapacityResult find_capacity(const Config& config, const TrialCriteria& criteria, int points,
                              bool quiet);
+
+// Number of trials the unseeded search (geometric growth from 0.125, then k-section) needs to
+// bracket a threshold at `lambda_star` within `tolerance`: replays the search with an oracle.
+int unseeded_trial_count(double lambda_star, double lambda_min, double tolerance, int points);
 
 }  // namespace voussoir

@@ -27,10 +27,22 @@ nlohmann::json hinges_json(const std::vector<Hinge>& hinges) {
 int command_capacity(const Config& config, const CommonOptions& common,
                      const CapacityOptions& opts) {
   const TrialCriteria criteria;
-  const CapacityResult res = find_capacity(config, criteria, opts.points, common.quiet);
+  CapacitySearch search;
+  search.points = opts.points;
+  search.quiet = common.quiet;
+  search.seed_from_limit = !opts.no_seed;
+  search.journal = opts.resume;
+  const CapacityResult res = find_capacity(config, criteria, search);
 
   std::printf("lambda* = %.4f  bracket [%.4f, %.4f]  %zu trials  %.1f s wall\n", res.lambda_star,
               res.lo, res.hi, res.trials.size(), res.wall_s);
+  if (res.seed.used)
+    std::printf("seeded from limit analysis lambda_la = %.4f: %s, %d trials against about %d "
+                "unseeded\n",
+                res.seed.lambda_la, res.seed.held ? "bracket held" : "bracket widened",
+                static_cast<int>(res.trials.size()), res.seed.unseeded_trials);
+  if (res.resumed_trials > 0)
+    std::printf("%d trials taken from the journal %s\n", res.resumed_trials, opts.resume.c_str());
   if (!res.bracketed)
     std::printf("no collapse found up to lambda = 8: lambda* is at least %.4f\n", res.lo);
   for (const Hinge& h : res.hinges)
@@ -59,7 +71,19 @@ int command_capacity(const Config& config, const CommonOptions& common,
                         {"dt", res.dt},
                         {"wall_s", res.wall_s},
                         {"points_per_round", opts.points},
-                        {"hinges", hinges_json(res.hinges)}};
+                        {"hinges", hinges_json(res.hinges)},
+                        {"resumed_trials", res.resumed_trials},
+                        {"seed",
+                         {{"used", res.seed.used},
+                          {"limit_status", res.seed.status},
+                          {"lambda_la", res.seed.used ? nlohmann::json(res.seed.lambda_la)
+                                                      : nlohmann::json(nullptr)},
+                          {"held", res.seed.held},
+                          {"widenings", res.seed.widenings},
+                          {"unseeded_trials_estimate", res.seed.unseeded_trials},
+                          {"trials_saved", res.seed.used ? res.seed.unseeded_trials -
+                                                               static_cast<int>(res.trials.size())
+                                                         : 0}}}};
     write_json(j, common.json_path);
   }
   return 0;

@@ -34,6 +34,8 @@ namespace voussoir {
 
 struct CapacityOptions {
   int points = 2;            // trial lambdas per bisection round (k-section with k = points+1)
+  bool no_seed = false;      // --no-seed: do not start from the limit-analysis bracket
+  std::string resume;        // --resume FILE: journal of finished trials (created if absent)
 };
 
 int command_capacity(const Config& config, const CommonOptions& common,

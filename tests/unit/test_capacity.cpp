@@ -4,9 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "drivers/capacity.hpp"
+#include "drivers/setup.hpp"
 #include "io/deck.hpp"
 
 namespace voussoir {
@@ -44,6 +48,55 @@ TEST(Capacity, BlockSlidesAtFriction) {
     if (t.lambda <= r.lo) EXPECT_FALSE(t.collapsed) << t.lambda;
     if (t.lambda >= r.hi) EXPECT_TRUE(t.collapsed) << t.lambda;
   }
+}
+
+// A capacity run killed after some trials resumes from its journal: the finished trials are
+// not run again and the result is the same bit for bit. The kill is imitated by cutting the
+// journal after three trials and half of the fourth line.
+TEST(Capacity, ResumesFromItsJournal) {
+  const std::string journal = ::testing::TempDir() + "capacity_resume.journal";
+  std::remove(journal.c_str());
+  CapacitySearch search;
+  search.quiet = true;
+  search.journal = journal;
+  const Config config = block_deck(0.3);
+  const CapacityResult full = find_capacity(config, TrialCriteria{}, search);
+  ASSERT_GE(full.trials.size(), 5u);
+  EXPECT_EQ(full.resumed_trials, 0);
+
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(journal);
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+  }
+  ASSERT_EQ(lines.size(), full.trials.size() + 1);  // header + one line per trial
+  {
+    std::ofstream out(journal, std::ios::trunc);
+    for (int i = 0; i < 4; ++i) out << lines[i] << '\n';
+    out << lines[4].substr(0, lines[4].size() / 2);  // the kill cut this line
+  }
+  const CapacityResult resumed = find_capacity(config, TrialCriteria{}, search);
+  EXPECT_EQ(resumed.resumed_trials, 3);
+  EXPECT_EQ(resumed.lambda_star, full.lambda_star);
+  EXPECT_EQ(resumed.lo, full.lo);
+  EXPECT_EQ(resumed.hi, full.hi);
+  ASSERT_EQ(resumed.trials.size(), full.trials.size());
+  for (size_t i = 0; i < full.trials.size(); ++i) {
+    EXPECT_EQ(resumed.trials[i].lambda, full.trials[i].lambda);
+    EXPECT_EQ(resumed.trials[i].collapsed, full.trials[i].collapsed);
+    EXPECT_EQ(resumed.trials[i].steps, full.trials[i].steps);
+  }
+  // A journal of other settings is refused rather than mixed in.
+  EXPECT_THROW(find_capacity(block_deck(0.8), TrialCriteria{}, search), RunError);
+}
+
+// The unseeded search replayed with an oracle: geometric growth 0.125, 0.25 | 0.5, 1 brackets
+// 0.3 in [0.25, 0.5] after 4 trials, then each round of 2 shrinks the bracket by 3.
+TEST(Capacity, UnseededTrialCountReplaysTheSearch) {
+  // Width 0.25 -> 0.0833 -> 0.0278 -> 0.00926 -> 0.00309 -> 0.00103 <= 0.005 x hi.
+  EXPECT_EQ(unseeded_trial_count(0.3, 0.0, 0.005, 2), 4 + 2 * 5);
+  // One point per round is plain bisection: 0.125 | 0.25 | 0.5 then halvings of 0.25.
+  EXPECT_EQ(unseeded_trial_count(0.3, 0.0, 0.005, 1), 3 + 8);
 }
 
 }  // namespace
