@@ -14,6 +14,7 @@
 #include "drivers/limit_command.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/stability.hpp"
 #include "io/deck.hpp"
 #include "voussoir/config.hpp"
 
@@ -55,6 +56,13 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "one simulation: HDF5 output and JSON summary");
   add_common(run, deck, common);
   run->add_option("-o,--output", run_opts.output, "HDF5 output file (overrides output.file)");
+  run->add_option("--checkpoint-every", run_opts.checkpoint_every,
+                  "write a checkpoint every T seconds of simulated time (and at the end)")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--checkpoint", run_opts.checkpoint,
+                  "checkpoint file (default OUTPUT.ckpt, or DECKNAME.ckpt without output)");
+  run->add_option("--restart", run_opts.restart,
+                  "continue the run saved in this checkpoint (same deck)");
 
   voussoir::CapacityOptions cap_opts;
   CLI::App* capacity =
@@ -104,8 +112,27 @@ int main(int argc, char** argv) {
       ->required();
   sweep->add_option("--csv", sweep_opts.csv, "CSV output (default sweep.csv)");
   sweep->add_option("--plot", sweep_opts.plot, "PNG plot of lambda* over the grid");
+  sweep->add_option("--resume", sweep_opts.resume,
+                    "journal of finished cells: created, or resumed after a kill");
   sweep->add_option("--points", sweep_opts.points, "trial lambdas per round (default 2)")
       ->check(CLI::Range(1, 64));
+
+  voussoir::StabilityOptions stab_opts;
+  CLI::App* stability = app.add_subcommand(
+      "stability", "gravity-only stability map over a grid (kinetic-energy criterion)");
+  add_common(stability, deck, common);
+  stability->add_option("--param", stab_opts.params,
+                        "KEY=V1,V2,... or KEY=start:stop:step (repeat for a grid); "
+                        "model.thickness_ratio=R sets model.thickness = R x model.radius")
+      ->required();
+  stability->add_option("--csv", stab_opts.csv, "CSV output (default stability.csv)");
+  stability->add_option("--plot", stab_opts.plot, "PNG map (scripts/plot_stability)");
+  stability->add_option("--mode-out", stab_opts.mode_out,
+                        "folder for the block outlines of every collapsed cell (JSON)");
+  stability->add_option("--ke-time", stab_opts.ke_time,
+                        "time at which the kinetic energy is read [s] (default 1)");
+  stability->add_option("--max-time", stab_opts.max_time,
+                        "simulated time after which undecided cells are decided [s] (default 3)");
 
   try {
     app.parse(argc, argv);
@@ -118,6 +145,8 @@ int main(int argc, char** argv) {
     if (common.threads > 0) omp_set_num_threads(common.threads);
     if (sweep->parsed())
       return voussoir::command_sweep(deck.deck, deck.sets, common, sweep_opts);
+    if (stability->parsed())
+      return voussoir::command_stability(deck.deck, deck.sets, common, stab_opts);
     const voussoir::Config config = voussoir::load_deck(deck.deck, deck.sets);
     if (check->parsed()) return voussoir::command_check(config, common, check_opts);
     if (run->parsed()) return voussoir::command_run(config, common, run_opts);

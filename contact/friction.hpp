@@ -29,7 +29,7 @@
 // normal row sum Ep thick g L of the same edge; max_omega_squared (contact/contact.cpp) adds
 // it in the tangential direction. Rejected 1/2: the tangential row would equal the normal one
 // and raise the bound at corner nodes (two perpendicular faces) from 1.5 to 2 times one face's
-// row, a 15% shorter stable step, for nothing. The elastic slip at stick, f_t / k_t, is
+// row, a 13% shorter stable step, for nothing. The elastic slip at stick, f_t / k_t, is
 // ~1e-9 m for masonry blocks, far below anything that matters.
 
 #include <cmath>

@@ -265,7 +265,7 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   const double c0x = mp.sx / mp.area, c0y = mp.sy / mp.area;
   out.centroid = {c0x + ox, c0y + oy};
   const double fx = d[0][0], fy = d[1][0];
-  const double moment = d[1][1] - d[0][2];  // sum over regions of Sx g_y - Sy g_x, times Ep
+  const double moment = d[1][1] - d[0][2];  // Ep int (x d_y phi - y d_x phi), c minus t
   const double f2 = fx * fx + fy * fy;
   for (int i = 0; i < 3; ++i) {
     out.bary_c[i] = bc.lam[i](c0x, c0y);

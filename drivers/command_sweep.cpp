@@ -70,9 +70,34 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   std::vector<CapacityResult> results(cells);
   std::vector<std::string> errors(cells);
   const TrialCriteria criteria;
+  // Resume: the journal holds one JSON line per finished cell ({"cell": i, "values": [...],
+  // result}); cells found there with the same values are not run again.
+  std::vector<bool> finished(cells, false);
+  if (!opts.resume.empty()) {
+    std::ifstream in(opts.resume);
+    for (std::string line; std::getline(in, line);) {
+      const auto j = nlohmann::json::parse(line, nullptr, false);
+      if (j.is_discarded() || !j.contains("cell")) continue;  // cut by a kill: run it again
+      const size_t c = j["cell"];
+      if (c >= cells || j["values"] != nlohmann::json(cell_values[c]))
+        throw DeckError("--resume " + opts.resume + ": the journal belongs to another sweep");
+      CapacityResult& r = results[c];
+      r.lambda_star = j["lambda_star"];
+      r.lo = j["lo"];
+      r.hi = j["hi"];
+      r.bracketed = j["bracketed"];
+      r.trials.resize(j["trials"].get<size_t>());
+      r.wall_s = j["wall_s"];
+      errors[c] = j["error"];
+      finished[c] = true;
+    }
+  }
+  std::ofstream journal;
+  if (!opts.resume.empty()) journal.open(opts.resume, std::ios::app);
   int done = 0;
 #pragma omp parallel for schedule(dynamic, 1)
   for (long c = 0; c < static_cast<long>(cells); ++c) {
+    if (finished[c]) continue;
     try {
       results[c] = find_capacity(configs[c], criteria, opts.points, true);
     } catch (const std::exception& e) {
@@ -80,6 +105,21 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
     }
 #pragma omp critical
     {
+      if (journal.is_open()) {
+        const CapacityResult& r = results[c];
+        journal << nlohmann::json{{"cell", c},
+                                  {"values", cell_values[c]},
+                                  {"lambda_star", r.lambda_star},
+                                  {"lo", r.lo},
+                                  {"hi", r.hi},
+                                  {"bracketed", r.bracketed},
+                                  {"trials", r.trials.size()},
+                                  {"wall_s", r.wall_s},
+                                  {"error", errors[c]}}
+                       .dump()
+                << '\n'
+                << std::flush;
+      }
       ++done;
       if (!common.quiet) {
         std::fprintf(stderr, "[%d/%zu]", done, cells);
@@ -96,9 +136,12 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
 
   const std::string csv_path = opts.csv.empty() ? "sweep.csv" : opts.csv;
   std::ofstream csv(csv_path + ".tmp");
+  csv.precision(17);
   if (!csv) throw OutputError("cannot write " + csv_path);
   for (const Axis& a : axes) csv << a.key << ',';
-  csv << "lambda_star,lo,hi,bracketed,trials,wall_s,error\n";
+  // The CSV holds results only (no wall times), so a resumed sweep writes the same file as an
+  // uninterrupted one; wall times are in the JSON and on stderr.
+  csv << "lambda_star,lo,hi,bracketed,trials,error\n";
   nlohmann::json jcells = nlohmann::json::array();
   for (size_t c = 0; c < cells; ++c) {
     const CapacityResult& r = results[c];
@@ -108,7 +151,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
       params[axes[k].key] = cell_values[c][k];
     }
     csv << r.lambda_star << ',' << r.lo << ',' << r.hi << ',' << (r.bracketed ? 1 : 0) << ','
-        << r.trials.size() << ',' << r.wall_s << ',' << '"' << errors[c] << '"' << '\n';
+        << r.trials.size() << ',' << '"' << errors[c] << '"' << '\n';
     jcells.push_back({{"params", params},
                       {"lambda_star", r.lambda_star},
                       {"bracket", {r.lo, r.hi}},

@@ -24,9 +24,20 @@ int command_check(const Config& config, const CommonOptions& common, const Check
 
 struct RunOptions {
   std::string output;        // -o FILE: HDF5 output (overrides output.file)
+  // Checkpoint and restart (io/checkpoint.hpp, docs/robustness.md):
+  double checkpoint_every = 0.0;  // --checkpoint-every T: every T s of simulated time; 0 = never
+  std::string checkpoint;    // --checkpoint FILE (default OUTPUT.ckpt, else DECKNAME.ckpt)
+  std::string restart;       // --restart FILE: continue the run saved in FILE
 };
 
 int command_run(const Config& config, const CommonOptions& common, const RunOptions& opts);
+
+struct Simulation;
+struct SetupInfo;
+// The body of command_run on a simulation already built by make_simulation(config, &info)
+// (tests inject a state or a time step here).
+int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
+                   const CommonOptions& common, const RunOptions& opts);
 
 }  // namespace voussoir
 
@@ -49,6 +60,7 @@ struct SweepOptions {
   std::vector<std::string> params;   // --param KEY=V1,V2,... (several make a grid)
   std::string csv;                   // --csv FILE (default: sweep.csv)
   std::string plot;                  // --plot FILE.png (drawn by scripts/plot_sweep)
+  std::string resume;                // --resume FILE: journal of finished cells
   int points = 2;
 };
 

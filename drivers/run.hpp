@@ -1,6 +1,21 @@
 #pragma once
 // The time loop shared by `run`, `capacity`, `pulse` and the tests: advance the simulation,
-// guard against non-finite state, sample the series, report progress.
+// guard against non-finite state and energy drift, sample the series, write checkpoints,
+// report progress.
+//
+// Guards (SPEC.md section 2: "no NaN silently written"; docs/robustness.md). At every sample:
+//   - non-finite: any node position or velocity, or any term of the energy ledger, that is
+//     NaN or infinite stops the run (check_finite);
+//   - energy drift: the ledger's balance error |W - K - U - C - D| / (peak energy) above
+//     kEnergyDriftLimit stops the run (check_energy_balance). The central-difference ledger
+//     of core/step.cpp is exact for linear systems and O(dt^2) otherwise: the stiff and
+//     extreme cases of tests/unit/test_stability.cpp stay below 1e-3 (docs/robustness.md), so
+//     5% is a factor of 50 above anything a sound run produces, while an unstable step makes
+//     the error grow geometrically and crosses it within a few tens of steps, long before a
+//     NaN. The error is relative to the largest energy term seen so far, so the threshold
+//     does not depend on the deck's units, size or load.
+// Both throw RunError (exit status 1) naming the step, the time and where: the node, its
+// block and a triangle that holds it.
 
 #include <cstdint>
 #include <functional>
@@ -10,12 +25,20 @@
 
 namespace voussoir {
 
+// Largest balance error of the energy ledger a run may reach (dimensionless, relative to the
+// peak energy; see above).
+inline constexpr double kEnergyDriftLimit = 0.05;
+
 // Largest displacement magnitude of any free node from its reference position [m].
 double max_free_displacement(const Model& model);
 
 // Throws RunError naming the step, time, block and triangle when any node position or velocity
-// is not finite.
+// or any energy of the ledger is not finite.
 void check_finite(const Simulation& sim);
+
+// Throws RunError naming the step, time and the fastest node (its block and a triangle) when
+// sim.ledger.balance_error() exceeds `limit`.
+void check_energy_balance(const Simulation& sim, double limit = kEnergyDriftLimit);
 
 struct LoopStats {
   long long steps = 0;
@@ -23,9 +46,31 @@ struct LoopStats {
   std::int64_t max_active_pairs = 0;
 };
 
-// Advances until `end_time`, calling `sample(sim)` every `sample_every` seconds of simulated
-// time (and once at the start and at the end); stops early when `sample` returns false.
-// Checks the state for non-finite numbers at every sample. Progress on stderr unless quiet.
+struct LoopOptions {
+  double end_time = 0.0;                   // [s] of simulated time, counted from step 0
+  double sample_every = 0.0;               // [s]; rounded to a whole number of steps (at least one)
+  bool quiet = false;                      // no progress on stderr
+  std::string label = "run";               // progress line prefix
+  double drift_limit = kEnergyDriftLimit;  // <= 0: energy guard off
+  // Checkpoints: `checkpoint(sim, stats)` after every `checkpoint_every` seconds of simulated
+  // time (rounded to whole steps, at least one; 0 = never), after that step's sample if it has
+  // one, never after the last step.
+  double checkpoint_every = 0.0;
+  std::function<void(const Simulation&, const LoopStats&)> checkpoint;
+};
+
+// Advances from sim.step until `end_time`, calling `sample(sim)` every `sample_every` seconds
+// of simulated time (steps that are multiples of the sample interval, and the last step), and
+// once at the start when starting from step 0; stops early when `sample` returns false.
+// Checks the guards above at every sample. Resumable: a simulation restored at step k
+// (io/checkpoint) continues exactly as the uninterrupted loop would, since samples and
+// checkpoints are placed by the absolute step number; `resume` carries the stats of the part
+// already run (max_active_pairs, wall_s), which the returned stats include.
+LoopStats run_loop(Simulation& sim, const LoopOptions& opts,
+                   const std::function<bool(const Simulation&)>& sample,
+                   const LoopStats& resume = {});
+
+// Same with the default guards and no checkpoints.
 LoopStats run_loop(Simulation& sim, double end_time, double sample_every,
                    const std::function<bool(const Simulation&)>& sample, bool quiet,
                    const std::string& label);

@@ -33,6 +33,16 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   set_static_load(sim, config.load.gravity, config.load.lambda);
 
   const double dt_stable = stable_time_step(sim);
+  // Infinite when nothing can vibrate (no free block); zero or NaN only when the material,
+  // mesh or penalty overflow double precision: refused, never run.
+  if (!(dt_stable > 0.0)) {
+    std::ostringstream msg;
+    msg << config.deck_path << ": the stable time step of this model is " << dt_stable
+        << " s: the material (young = " << config.material.young
+        << " Pa, density = " << config.material.density << " kg/m3), the mesh or the contact "
+        << "penalty (" << cp.penalty << " Pa) are out of range";
+    throw DeckError(msg.str());
+  }
   double dt = config.solver.dt_safety * dt_stable;
   if (config.solver.dt > 0.0) {
     if (config.solver.dt > dt_stable) {

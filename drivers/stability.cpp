@@ -1,0 +1,382 @@
+// Gravity-only stability maps: one cell = one deck run from rest under gravity, classified
+// stable or collapsed; the criteria, the kinetic-energy normalisation and the limit-analysis
+// cross-check are described at the top of drivers/stability.hpp.
+
+#include "drivers/stability.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+
+#include "drivers/run.hpp"
+#include "drivers/setup.hpp"
+#include "io/deck.hpp"
+#include "limit/limit_analysis.hpp"
+#include "mesh/scene.hpp"
+
+namespace voussoir {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Criteria are read every kSampleTime of simulated time (as in capacity trials).
+constexpr double kSampleTime = 1e-3;  // [s]
+
+// Hinge report thresholds: gap or slip above 1% of L_ref (as in capacity).
+constexpr double kHingeFraction = 0.01;
+
+// Whole text parsed as a finite number.
+bool parse_number(const std::string& s, double& v) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  v = std::strtod(s.c_str(), &end);
+  return end == s.c_str() + s.size() && std::isfinite(v);
+}
+
+// Digits after the decimal point of a plain decimal ("0.05" -> 2, "3" -> 0); -1 when the
+// number has an exponent (printed with %.12g then).
+int decimals_of(const std::string& s) {
+  if (s.find_first_of("eE") != std::string::npos) return -1;
+  const auto dot = s.find('.');
+  return dot == std::string::npos ? 0 : static_cast<int>(s.size() - dot - 1);
+}
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+std::string format_number(double v, int decimals) {
+  char buf[64];
+  if (decimals >= 0)
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  else
+    std::snprintf(buf, sizeof buf, "%.12g", v);
+  std::string s = buf;
+  if (s == "-0" || s.rfind("-0.", 0) == 0) {  // no negative zero from rounding
+    double z = 0.0;
+    if (parse_number(s, z) && z == 0.0) s = s.substr(1);
+  }
+  return s;
+}
+
+// Largest speed of any free node [m/s].
+double max_free_speed(const Nodes& n) {
+  double v2 = 0.0;
+  for (Index i = 0; i < n.size(); ++i)
+    if (n.inv_mass[i] != 0.0) v2 = std::max(v2, n.vx[i] * n.vx[i] + n.vy[i] * n.vy[i]);
+  return std::sqrt(v2);
+}
+
+// Square root of the smallest free block area [m] (capacity's L_ref).
+double reference_length(const Model& model) {
+  double a = std::numeric_limits<double>::infinity();
+  for (const Block& b : model.blocks)
+    if (!b.fixed) a = std::min(a, b.area);
+  return std::isfinite(a) ? std::sqrt(a) : 1.0;
+}
+
+bool is_arch(const std::string& kind) {
+  return kind == "circular_arch" || kind == "basket_arch" || kind == "buttressed_arch";
+}
+
+}  // namespace
+
+std::vector<std::string> expand_range(const std::string& spec) {
+  std::vector<std::string> parts;
+  std::stringstream ss(spec);
+  std::string p;
+  while (std::getline(ss, p, ':')) parts.push_back(trim(p));
+  double start = 0.0, stop = 0.0, step = 0.0;
+  if (parts.size() != 3 || !parse_number(parts[0], start) || !parse_number(parts[1], stop) ||
+      !parse_number(parts[2], step))
+    throw DeckError("range '" + spec + "': expected start:stop:step (three numbers)");
+  if (!(step > 0.0)) throw DeckError("range '" + spec + "': the step must be positive");
+  if (stop < start) throw DeckError("range '" + spec + "': stop is below start");
+  // Count by integer steps with a tolerance of 1e-9 step, so a stop on the grid is included
+  // whatever the rounding of (stop - start) / step.
+  const double span = (stop - start) / step;
+  if (span > 1e6) throw DeckError("range '" + spec + "': more than a million values");
+  const long n = static_cast<long>(std::floor(span + 1e-9)) + 1;
+  int decimals = -1;
+  const int d0 = decimals_of(parts[0]), d2 = decimals_of(parts[2]);
+  if (d0 >= 0 && d2 >= 0) decimals = std::max(d0, d2);
+  std::vector<std::string> out;
+  out.reserve(n);
+  for (long i = 0; i < n; ++i) out.push_back(format_number(start + i * step, decimals));
+  return out;
+}
+
+StabilityAxis parse_stability_param(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+    throw DeckError("--param '" + text + "': expected KEY=V1,V2,... or KEY=start:stop:step");
+  StabilityAxis a;
+  a.key = trim(text.substr(0, eq));
+  std::stringstream ss(text.substr(eq + 1));
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    item = trim(item);
+    if (item.empty()) throw DeckError("--param '" + text + "': empty value in the list");
+    if (item.find(':') != std::string::npos) {
+      for (std::string& v : expand_range(item)) a.values.push_back(std::move(v));
+    } else {
+      a.values.push_back(item);
+    }
+  }
+  if (a.key == kThicknessRatioKey)
+    for (const std::string& v : a.values) {
+      double r = 0.0;
+      if (!parse_number(v, r) || !(r > 0.0))
+        throw DeckError("--param '" + text +
+                        "': model.thickness_ratio must be positive numbers, "
+                        "got '" +
+                        v + "'");
+    }
+  return a;
+}
+
+double stability_ke_length(const Config& config, const Model& model) {
+  if (is_arch(config.model.kind)) return config.model.radius;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Block& b : model.blocks)
+    if (!b.fixed)
+      for (const Vec2& p : b.polygon) {
+        lo = std::min(lo, p.y);
+        hi = std::max(hi, p.y);
+      }
+  return hi > lo ? hi - lo : 1.0;
+}
+
+StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& crit,
+                                 bool keep_mode) {
+  const auto t0 = Clock::now();
+  Config config = deck;
+  config.load.lambda = 0.0;  // gravity only
+  config.load.base.signal = "none";
+  config.output.file.clear();
+  Simulation sim = make_simulation(config);
+  const TrialCriteria& tc = crit.trial;
+
+  StabilityCell c;
+  c.thickness = config.model.thickness;
+  c.radius = config.model.radius;
+  c.friction = config.contact.friction;
+  c.triangles = sim.model.tris.size();
+  c.dt = sim.ctx.dt;
+  c.l_ref = reference_length(sim.model);
+  c.free_mass = free_mass(sim.model);
+  c.ke_length = stability_ke_length(config, sim.model);
+  const double g = config.load.gravity;
+  const double ke_scale = c.free_mass * g * c.ke_length;
+  const long long every = std::max(1LL, std::llround(kSampleTime / sim.ctx.dt));
+  const double v_rest = tc.rest_speed * std::sqrt(std::max(g, 1e-12) * c.l_ref);
+  const double d_collapse = tc.collapse_displacement * c.l_ref;
+  const std::vector<BlockMotion> base = block_motions(sim.model);  // rest, unloaded
+
+  std::vector<double> measure;  // motion measure per sample (1 = collapse threshold)
+  double rest_since = -1.0;
+  bool decided = false, ke_read = false;
+  while (!(decided && ke_read)) {
+    const double t = sim.ctx.time;
+    set_static_load(sim, g * std::min(1.0, t / tc.ramp_time), 0.0);
+    advance(sim);
+    if (sim.step % every != 0) continue;
+    check_finite(sim);
+    const double now = sim.ctx.time;
+    const std::vector<BlockMotion> m = block_motions(sim.model);
+    double dmax = 0.0, rmax = 0.0;
+    for (size_t b = 0; b < m.size(); ++b) {
+      if (sim.model.blocks[b].fixed) continue;
+      dmax = std::max(dmax, std::hypot(m[b].ux - base[b].ux, m[b].uy - base[b].uy));
+      rmax = std::max(rmax, std::abs(m[b].rotation - base[b].rotation));
+    }
+    c.max_displacement = dmax;
+    c.max_rotation = rmax;
+    if (!ke_read && now >= crit.ke_time) {
+      c.kinetic_energy = sim.ledger.kinetic;
+      c.ke_read_time = now;
+      ke_read = true;
+    }
+    if (decided) continue;
+    measure.push_back(std::max(dmax / d_collapse, rmax / tc.collapse_rotation));
+    if (dmax > d_collapse || rmax > tc.collapse_rotation) {
+      c.stable = false;
+      c.reason = dmax > d_collapse ? "displacement" : "rotation";
+      decided = true;
+    } else if (now >= tc.ramp_time) {
+      if (max_free_speed(sim.model.nodes) < v_rest) {
+        if (rest_since < 0.0) rest_since = now;
+        if (now - rest_since >= tc.hold_time) {
+          c.stable = true;
+          c.reason = "rest";
+          decided = true;
+        }
+      } else {
+        rest_since = -1.0;
+      }
+      if (!decided && now >= tc.max_time) {
+        // Critical slowing down near the threshold: decide by the trend, as capacity does
+        // (drivers/capacity.cpp): collapsed when the motion measure now exceeds by 10% its
+        // largest value over the first two thirds of the run.
+        const size_t cut = measure.size() * 2 / 3;
+        const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
+        c.stable = !(measure.back() > 1.1 * earlier);
+        c.reason = "timeout";
+        decided = true;
+      }
+    }
+    if (decided) {
+      c.decision_time = now;
+      // At rest before ke_time: stop and report the energy at the decision (an upper bound
+      // of the value at ke_time).
+      if (c.stable && !ke_read) {
+        c.kinetic_energy = sim.ledger.kinetic;
+        c.ke_read_time = now;
+        ke_read = true;
+      }
+    }
+  }
+  c.normalised_ke = ke_scale > 0.0 ? c.kinetic_energy / ke_scale : 0.0;
+  c.sim_time = sim.ctx.time;
+  c.steps = sim.step;
+  if (!c.stable) {
+    const double tol = kHingeFraction * c.l_ref;
+    c.hinges = find_hinges(sim.model, tol, tol);
+  }
+  if (keep_mode) {
+    const std::vector<BlockMotion> m = block_motions(sim.model);
+    for (size_t b = 0; b < sim.model.blocks.size(); ++b) {
+      const Block& blk = sim.model.blocks[b];
+      std::vector<Vec2> moved;
+      moved.reserve(blk.polygon.size());
+      for (const Vec2& p : blk.polygon) moved.push_back(blk.fixed ? p : move_point(m[b], p));
+      c.outlines.push_back(std::move(moved));
+      c.outlines0.push_back(blk.polygon);
+      c.fixed.push_back(blk.fixed);
+    }
+  }
+  c.wall_s = seconds_since(t0);
+  return c;
+}
+
+void check_limit_admissibility(const Config& config, StabilityCell& cell) {
+  try {
+    const Model model = build_model(config);
+    const LimitResult r = limit_analysis(model, config.contact.friction, config.load.gravity, true);
+    cell.la_admissible = r.admissible;
+    cell.la_status = r.status;
+  } catch (const std::exception& e) {
+    cell.la_admissible = false;
+    cell.la_status = std::string("error: ") + e.what();
+  }
+}
+
+StabilityGrid make_stability_grid(const std::string& deck_path,
+                                  const std::vector<std::string>& sets,
+                                  const std::vector<StabilityAxis>& axes) {
+  StabilityGrid grid;
+  grid.axes = axes;
+  size_t cells = 1;
+  for (const StabilityAxis& a : axes) {
+    if (a.values.empty()) throw DeckError("--param " + a.key + ": no values");
+    cells *= a.values.size();
+  }
+  for (size_t c = 0; c < cells; ++c) {
+    size_t rest = c;
+    std::vector<std::string> vals(axes.size());
+    for (size_t k = axes.size(); k-- > 0;) {
+      vals[k] = axes[k].values[rest % axes[k].values.size()];
+      rest /= axes[k].values.size();
+    }
+    std::vector<std::string> cell_sets = sets;
+    const StabilityAxis* ratio = nullptr;
+    std::string ratio_value;
+    for (size_t k = 0; k < axes.size(); ++k) {
+      if (axes[k].key == kThicknessRatioKey) {
+        ratio = &axes[k];
+        ratio_value = vals[k];
+      } else {
+        cell_sets.push_back(axes[k].key + "=" + vals[k]);
+      }
+    }
+    if (ratio) {
+      // thickness = ratio x radius of this cell's deck (after every other override).
+      const Config partial = load_deck(deck_path, cell_sets);
+      const double t = std::strtod(ratio_value.c_str(), nullptr) * partial.model.radius;
+      cell_sets.push_back("model.thickness=" + format_number(t, -1));
+    }
+    grid.configs.push_back(load_deck(deck_path, cell_sets));
+    grid.values.push_back(std::move(vals));
+  }
+  return grid;
+}
+
+std::vector<StabilityCell> run_stability_map(const StabilityGrid& grid,
+                                             const StabilityCriteria& crit, int threads,
+                                             bool keep_modes, bool quiet) {
+  const long cells = static_cast<long>(grid.configs.size());
+  // Limit-analysis cross-checks first, serially (a few ms each; GLPK is not assumed to be
+  // thread-safe), so progress lines can flag disagreements.
+  std::vector<StabilityCell> la(cells);
+  for (long c = 0; c < cells; ++c) check_limit_admissibility(grid.configs[c], la[c]);
+
+  std::vector<StabilityCell> out(cells);
+  const int nthreads = threads > 0 ? threads : omp_get_max_threads();
+  const auto t0 = Clock::now();
+  int done = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
+  for (long c = 0; c < cells; ++c) {
+    StabilityCell& r = out[c];
+    try {
+      r = run_stability_cell(grid.configs[c], crit, keep_modes);
+      if (r.stable) {  // outlines are only wanted for collapse modes
+        r.outlines.clear();
+        r.outlines0.clear();
+        r.fixed.clear();
+      }
+    } catch (const std::exception& e) {
+      r.error = e.what();
+      r.reason = "error";
+      r.thickness = grid.configs[c].model.thickness;
+      r.radius = grid.configs[c].model.radius;
+      r.friction = grid.configs[c].contact.friction;
+    }
+    r.values = grid.values[c];
+    r.la_admissible = la[c].la_admissible;
+    r.la_status = la[c].la_status;
+#pragma omp critical(stability_progress)
+    {
+      ++done;
+      if (!quiet) {
+        std::fprintf(stderr, "[%d/%ld]", done, cells);
+        for (size_t k = 0; k < grid.axes.size(); ++k)
+          std::fprintf(stderr, " %s=%s", grid.axes[k].key.c_str(), grid.values[c][k].c_str());
+        if (r.error.empty())
+          std::fprintf(stderr,
+                       "  %-9s (%s at %.3f s) KE/MgL = %.3g at %.3f s; LA %s%s; %.1f s wall, "
+                       "%.0f s elapsed\n",
+                       r.stable ? "stable" : "collapsed", r.reason.c_str(), r.decision_time,
+                       r.normalised_ke, r.ke_read_time,
+                       r.la_admissible ? "admissible" : "not admissible",
+                       r.disagrees() ? " (DISAGREES)" : "", r.wall_s, seconds_since(t0));
+        else
+          std::fprintf(stderr, "  failed: %s\n", r.error.c_str());
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace voussoir

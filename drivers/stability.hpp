@@ -1,0 +1,148 @@
+#pragma once
+// Gravity-only stability maps (SPEC.md section 2, `voussoir stability`; docs/dynamics.md
+// "Gilbert arch stability map").
+//
+// A cell of the map is one deck (the base deck with the cell's `--param` values applied) run
+// from rest under gravity alone (load.lambda and any base motion switched off):
+//   1. gravity is ramped from 0 to g over `ramp_time` (a ramp, not a step, as in capacity's
+//      settle: a step overshoots the static contact response and would open joints);
+//   2. the cell is classified with the thresholds of a capacity trial (drivers/capacity.hpp,
+//      TrialCriteria defaults, measured from the initial, unloaded geometry):
+//        collapsed as soon as any free block's centroid has moved more than
+//          collapse_displacement x L_ref (0.05 L_ref) or rotated more than collapse_rotation
+//          (0.05 rad), L_ref = square root of the smallest free block area;
+//        stable as soon as, after the ramp, the largest free-node speed has stayed below
+//          rest_speed x sqrt(g L_ref) (1e-4) for hold_time (0.05 s);
+//        otherwise at `max_time` (3 s of simulated time from the start): collapsed if the motion
+//          measure max(d / d_collapse, |rotation| / rot_collapse) at the end exceeds by 10% its
+//          largest value over the first two thirds of the run, stable otherwise ("timeout").
+//   3. the normalised kinetic energy KE / (M g L) is read at `ke_time` (1 s by default, from the
+//      start of the gravity ramp), M the free mass and L the reference length of the scene
+//      (`ke_length`: the centreline radius Rc for arches, the height of the free blocks'
+//      bounding box for other scenes). It is the fraction of the potential energy of a drop
+//      of L that has turned into motion. Collapsed cells are run on to `ke_time` when they
+//      cross the collapse threshold earlier; a cell found at rest before `ke_time` is stopped
+//      there and reports the kinetic energy at the rest decision (a structure at rest under
+//      a constant load stays at rest, so this bounds the value at ke_time from above).
+//   4. cross-check: rigid-block limit analysis (limit/limit_analysis.hpp, gravity only) on the
+//      same blocks says whether an admissible equilibrium exists; `disagree` flags cells where
+//      the FDEM classification differs from it. Limit analysis assumes associative friction and
+//      rigid blocks, so near the friction threshold (sliding) it may call admissible a cell that
+//      collapses by non-associative sliding.
+//
+// Cells run in parallel (OpenMP over cells, dynamic schedule); each cell is a serial
+// simulation, so results do not depend on the thread count.
+
+#include <string>
+#include <vector>
+
+#include "core/model.hpp"
+#include "drivers/capacity.hpp"
+#include "drivers/commands.hpp"
+#include "drivers/kinematics.hpp"
+#include "io/config.hpp"
+
+namespace voussoir {
+
+// One axis of the map, from `--param KEY=V1,V2,...` or `--param KEY=start:stop:step`.
+// The key `model.thickness_ratio` is a convenience: the cell's model.thickness becomes
+// ratio x model.radius (the radius of the cell's deck).
+struct StabilityAxis {
+  std::string key;
+  std::vector<std::string> values;  // as written to the deck override
+};
+
+inline constexpr const char* kThicknessRatioKey = "model.thickness_ratio";
+
+// Expands "start:stop:step" into decimal strings start, start + step, ... up to stop included
+// when stop lies on the grid (within 1e-9 of a step). Each value is computed as
+// start + i x step and printed with the number of decimals of the inputs, so 0.2:0.8:0.05
+// gives exactly "0.20", "0.25", ..., "0.80" (13 values, no floating drift). Throws DeckError
+// for a non-positive step, stop < start or text that is not three numbers.
+std::vector<std::string> expand_range(const std::string& spec);
+
+// Parses one --param; throws DeckError naming the text when malformed.
+StabilityAxis parse_stability_param(const std::string& text);
+
+struct StabilityCriteria {
+  TrialCriteria trial;   // thresholds shared with capacity (ramp, collapse, rest, max_time)
+  double ke_time = 1.0;  // [s] from the start of the gravity ramp
+};
+
+struct StabilityCell {
+  std::vector<std::string> values;  // per axis, as in StabilityAxis::values
+  double thickness = 0.0;           // model.thickness of the cell [m]
+  double radius = 0.0;              // model.radius of the cell [m]
+  double friction = 0.0;            // contact.friction of the cell
+  bool stable = false;
+  std::string reason;             // "rest", "displacement", "rotation", "timeout", "error"
+  double kinetic_energy = 0.0;    // [J per out_of_plane] at ke_read_time
+  double normalised_ke = 0.0;     // kinetic_energy / (M g L)
+  double ke_read_time = 0.0;      // [s] when the kinetic energy was read
+  double ke_length = 0.0;         // L [m]
+  double free_mass = 0.0;         // M [kg]
+  double max_displacement = 0.0;  // largest block centroid displacement at the end [m]
+  double max_rotation = 0.0;      // largest block rotation at the end [rad]
+  double decision_time = 0.0;     // [s] simulated when the classification was made
+  double sim_time = 0.0;          // [s] simulated in total
+  long long steps = 0;
+  double wall_s = 0.0;
+  Index triangles = 0;
+  double dt = 0.0;             // [s]
+  double l_ref = 0.0;          // [m]
+  bool la_admissible = false;  // limit analysis: admissible equilibrium under gravity
+  std::string la_status;       // limit analysis status ("optimal"/"infeasible"/...)
+  std::string error;           // non-empty when the cell failed
+  std::vector<Hinge> hinges;   // collapsed cells: joints open or sliding at the end
+  // Kept when asked (mode pictures): block outlines at the end of the run (reference polygon
+  // moved by the block's rigid motion) and the reference outlines.
+  std::vector<std::vector<Vec2>> outlines, outlines0;
+  std::vector<bool> fixed;  // per block
+  bool disagrees() const { return error.empty() && stable != la_admissible; }
+};
+
+// Length L of the kinetic-energy normalisation for this deck (see the top of this file).
+double stability_ke_length(const Config& config, const Model& model);
+
+// Runs one cell (the deck as given, lambda and base motion ignored); `keep_mode` keeps the
+// block outlines at the end. Throws RunError on a non-finite state.
+StabilityCell run_stability_cell(const Config& config, const StabilityCriteria& criteria,
+                                 bool keep_mode);
+
+// The limit-analysis cross-check of one cell (fills la_admissible and la_status). GLPK is not
+// assumed thread-safe: call it outside parallel regions.
+void check_limit_admissibility(const Config& config, StabilityCell& cell);
+
+struct StabilityGrid {
+  std::vector<StabilityAxis> axes;
+  std::vector<Config> configs;                   // row-major, last axis fastest
+  std::vector<std::vector<std::string>> values;  // per cell, per axis
+};
+
+// Builds every cell's deck (validated up front, so a bad value stops the map before any
+// work) from the deck file, the --set overrides and the axes.
+StabilityGrid make_stability_grid(const std::string& deck_path,
+                                  const std::vector<std::string>& sets,
+                                  const std::vector<StabilityAxis>& axes);
+
+// Runs every cell of the grid, in parallel over cells on `threads` threads (0 = OpenMP
+// default), then the limit-analysis cross-checks. `keep_modes` keeps the outlines of
+// collapsed cells. Progress lines on stderr unless quiet. A failing cell is reported in its
+// `error`, the others still run.
+std::vector<StabilityCell> run_stability_map(const StabilityGrid& grid,
+                                             const StabilityCriteria& criteria, int threads,
+                                             bool keep_modes, bool quiet);
+
+struct StabilityOptions {
+  std::vector<std::string> params;  // --param KEY=V1,V2,... or KEY=start:stop:step
+  std::string csv;                  // --csv FILE (default stability.csv)
+  std::string plot;                 // --plot FILE.png (scripts/plot_stability)
+  std::string mode_out;             // --mode-out DIR: outlines of every collapsed cell
+  double ke_time = 1.0;             // --ke-time [s]
+  double max_time = 3.0;            // --max-time [s]
+};
+
+int command_stability(const std::string& deck_path, const std::vector<std::string>& sets,
+                      const CommonOptions& common, const StabilityOptions& opts);
+
+}  // namespace voussoir

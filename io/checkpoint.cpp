@@ -1,0 +1,294 @@
+// Checkpoint files (layout and contract in io/checkpoint.hpp).
+
+#include "io/checkpoint.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <concepts>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <type_traits>
+
+#include "io/deck.hpp"
+#include "io/json.hpp"
+
+namespace voussoir {
+
+namespace {
+
+constexpr char kMagic[] = "VOUSSOIR-CKPT\n";  // 14 characters, no terminator written
+constexpr std::size_t kMagicSize = sizeof(kMagic) - 1;
+constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kByteOrderTag = 0x01020304u;
+
+// The contact state interface requested from contact/ (io/checkpoint.hpp "Contact state"),
+// detected at compile time so that this file builds with and without it.
+template <class C>
+concept HasContactState = requires(const C& c, C& m, const std::vector<char>& bytes) {
+  { c.save_state() } -> std::convertible_to<std::vector<char>>;
+  m.restore_state(bytes);
+};
+
+template <class C>
+std::vector<char> save_contact(const C& contact) {
+  if constexpr (HasContactState<C>) {
+    return contact.save_state();
+  } else {
+    return {};
+  }
+}
+
+template <class C>
+void restore_contact(C& contact, const std::vector<char>& bytes) {
+  if constexpr (HasContactState<C>) {
+    contact.restore_state(bytes);
+  } else {
+    // A fresh set-up re-detects at the first step: exact without friction (header).
+    (void)contact;
+    (void)bytes;
+  }
+}
+
+// FNV-1a, 64 bit.
+struct Fnv {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  void bytes(const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    for (std::size_t k = 0; k < n; ++k) {
+      h ^= c[k];
+      h *= 0x100000001b3ull;
+    }
+  }
+  template <class T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(&v, sizeof v);
+  }
+  template <class T>
+  void array(const std::vector<T>& v) {
+    value<std::uint64_t>(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+};
+
+// Serialisation into a byte string.
+struct Out {
+  std::string buf;
+  void bytes(const void* p, std::size_t n) { buf.append(static_cast<const char*>(p), n); }
+  template <class T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(&v, sizeof v);
+  }
+  template <class T>
+  void array(const std::vector<T>& v) {
+    value<std::uint64_t>(v.size());
+    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+  }
+};
+
+// Bounds-checked reading from the file contents; every failure names the file.
+struct In {
+  const std::string& buf;
+  const std::string& path;
+  std::size_t pos = 0;
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw DeckError("restart file '" + path + "': " + why);
+  }
+  void bytes(void* p, std::size_t n) {
+    if (n > buf.size() - pos) fail("truncated (not a complete checkpoint)");
+    std::memcpy(p, buf.data() + pos, n);
+    pos += n;
+  }
+  template <class T>
+  T value() {
+    T v{};
+    bytes(&v, sizeof v);
+    return v;
+  }
+  template <class T>
+  std::vector<T> array() {
+    const auto n = value<std::uint64_t>();
+    if (n > (buf.size() - pos) / sizeof(T)) fail("truncated (not a complete checkpoint)");
+    std::vector<T> v(n);
+    if (n > 0) bytes(v.data(), n * sizeof(T));
+    return v;
+  }
+};
+
+// Writes `data` to `path` atomically: PATH.tmp, fsync, rename.
+void write_file_atomically(const std::string& path, const std::string& data) {
+  const std::string tmp = path + ".tmp";
+  auto fail = [&](const std::string& what) {
+    throw OutputError("cannot write checkpoint '" + path + "': " + what + ": " +
+                      std::strerror(errno));
+  };
+  std::error_code ec;
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail("open " + tmp);
+  std::size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      ::close(fd);
+      fail("write " + tmp);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    ::close(fd);
+    fail("fsync " + tmp);
+  }
+  if (::close(fd) != 0) fail("close " + tmp);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail("rename " + tmp);
+}
+
+}  // namespace
+
+bool contact_history_saved() {
+  return HasContactState<ContactSystem>;
+}
+
+std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
+  const Model& m = sim.model;
+  Fnv f;
+  f.array(m.nodes.x0);
+  f.array(m.nodes.y0);
+  f.array(m.nodes.mass);
+  f.array(m.nodes.inv_mass);
+  f.array(m.nodes.block);
+  f.array(m.tris.n0);
+  f.array(m.tris.n1);
+  f.array(m.tris.n2);
+  f.array(m.tris.block);
+  f.value(m.material.density);
+  f.value(m.material.young);
+  f.value(m.material.poisson);
+  f.value(m.material.plane_stress);
+  f.value(m.out_of_plane);
+  const StepContext& c = sim.ctx;
+  for (const double v : {c.dt, c.body_ax, c.body_ay, c.lame_lambda, c.shear_modulus, c.eta})
+    f.value(v);
+  f.value(c.contact_on);
+  f.value(sim.contact.penalty());
+  f.value(sim.contact.buffer());
+  f.value(friction);
+  return f.h;
+}
+
+void write_checkpoint(const std::string& path, const Simulation& sim, std::uint64_t fingerprint,
+                      double friction, const std::vector<double>& driver_state) {
+  if (sim.ctx.contact_on && friction > 0.0 && !contact_history_saved())
+    throw OutputError("cannot write checkpoint '" + path +
+                      "': the friction history of the contact pairs cannot be saved by this "
+                      "build (ContactSystem has no save_state); checkpoints need "
+                      "contact.friction = 0 here");
+  Out o;
+  o.bytes(kMagic, kMagicSize);
+  o.value(kVersion);
+  o.value(kByteOrderTag);
+  o.value(fingerprint);
+  o.value<std::int64_t>(sim.step);
+  const StepContext& c = sim.ctx;
+  for (const double v : {c.time, c.dt, c.prev_body_ax, c.prev_body_ay}) o.value(v);
+  const EnergyLedger& l = sim.ledger;
+  for (const double v : {l.kinetic, l.strain, l.contact, l.external_work, l.damping_dissipated,
+                         l.friction_dissipated, l.max_energy})
+    o.value(v);
+  const Nodes& n = sim.model.nodes;
+  o.array(n.x);
+  o.array(n.y);
+  o.array(n.vx);
+  o.array(n.vy);
+  o.array(sim.viscous_piola);
+  o.value<std::uint8_t>(contact_history_saved() ? 1 : 0);
+  o.array(save_contact(sim.contact));
+  o.array(driver_state);
+  Fnv sum;
+  sum.bytes(o.buf.data(), o.buf.size());
+  o.value(sum.h);
+  write_file_atomically(path, o.buf);
+}
+
+std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
+                                    std::uint64_t fingerprint) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw DeckError("restart file '" + path + "': no such file");
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream text;
+  text << file.rdbuf();
+  if (!file) throw DeckError("restart file '" + path + "': cannot read it");
+  const std::string buf = text.str();
+  In in{buf, path};
+
+  if (buf.size() < kMagicSize + sizeof(std::uint64_t) ||
+      buf.compare(0, kMagicSize, kMagic, kMagicSize) != 0)
+    in.fail("not a voussoir checkpoint");
+  Fnv sum;
+  sum.bytes(buf.data(), buf.size() - sizeof(std::uint64_t));
+  std::uint64_t stored_sum = 0;
+  std::memcpy(&stored_sum, buf.data() + buf.size() - sizeof stored_sum, sizeof stored_sum);
+  if (stored_sum != sum.h) in.fail("checksum mismatch (truncated or corrupt)");
+  in.pos = kMagicSize;
+  if (const auto v = in.value<std::uint32_t>(); v != kVersion)
+    in.fail("format version " + std::to_string(v) + ", this program reads version " +
+            std::to_string(kVersion));
+  if (in.value<std::uint32_t>() != kByteOrderTag)
+    in.fail("written on a machine of another byte order");
+  if (in.value<std::uint64_t>() != fingerprint)
+    in.fail(
+        "written for another model (the deck or a --set that shapes the model, material, "
+        "contact, loads or time step differs)");
+
+  const auto step = in.value<std::int64_t>();
+  const double time = in.value<double>();
+  const double dt = in.value<double>();
+  const double prev_ax = in.value<double>();
+  const double prev_ay = in.value<double>();
+  if (dt != sim.ctx.dt) in.fail("written with another time step");
+  EnergyLedger l;
+  for (double* v : {&l.kinetic, &l.strain, &l.contact, &l.external_work, &l.damping_dissipated,
+                    &l.friction_dissipated, &l.max_energy})
+    *v = in.value<double>();
+  std::vector<double> x = in.array<double>(), y = in.array<double>();
+  std::vector<double> vx = in.array<double>(), vy = in.array<double>();
+  std::vector<double> piola = in.array<double>();
+  const auto contact_kind = in.value<std::uint8_t>();
+  const std::vector<char> contact = in.array<char>();
+  std::vector<double> driver = in.array<double>();
+  if (in.pos + sizeof(std::uint64_t) != buf.size()) in.fail("unexpected data after the state");
+  const std::size_t nodes = sim.model.nodes.x.size();
+  if (step < 0 || x.size() != nodes || y.size() != nodes || vx.size() != nodes ||
+      vy.size() != nodes)
+    in.fail("node count differs from the model");
+  if (!piola.empty() && piola.size() != 4 * std::size_t(sim.model.tris.size()))
+    in.fail("triangle count differs from the model");
+  if (contact_kind != (contact_history_saved() ? 1 : 0))
+    in.fail("contact state written by a build with another contact interface");
+
+  sim.step = step;
+  sim.ctx.time = time;
+  sim.ctx.prev_body_ax = prev_ax;
+  sim.ctx.prev_body_ay = prev_ay;
+  sim.ledger = l;
+  Nodes& n = sim.model.nodes;
+  n.x = std::move(x);
+  n.y = std::move(y);
+  n.vx = std::move(vx);
+  n.vy = std::move(vy);
+  sim.viscous_piola = std::move(piola);
+  restore_contact(sim.contact, contact);
+  return driver;
+}
+
+}  // namespace voussoir
