@@ -76,6 +76,10 @@ int main(int argc, char** argv) {
                      "start from the generic bracket, not from limit analysis");
   capacity->add_option("--resume", cap_opts.resume,
                        "journal of finished trials: created, or resumed after a kill");
+  capacity->add_option("--mode-out", cap_opts.mode_out,
+                       "JSON of the deformed collapse state with its hinges");
+  capacity->add_option("--picture", cap_opts.picture,
+                       "picture (PNG/SVG) of the failure mode with hinges marked");
 
   voussoir::LimitCommandOptions limit_opts;
   CLI::App* limit =

@@ -47,9 +47,12 @@ namespace voussoir {
 
 namespace {
 
-// Fewer candidate pairs than this are evaluated on one thread (a parallel region costs a few
-// microseconds, about ten pair evaluations).
-constexpr std::size_t kParallelPairs = 128;
+// Fewer candidate pairs than this are evaluated on one thread. A parallel region costs a few
+// microseconds on an idle machine (about ten pair evaluations), but when the cores are shared
+// (capacity and sweep run trials side by side, ctest runs tests side by side) each per-step
+// region waits for a descheduled thread: at 128 the 1388-triangle arch ran 30x slower on two
+// threads than on one on the loaded 2-core machine. Parallel pairs pay only on large scenes.
+constexpr std::size_t kParallelPairs = 8192;
 
 // What one pair adds: nodal forces (potential + friction), stored and dissipated energy.
 struct PairResult {

@@ -46,6 +46,41 @@ constexpr double kSampleTime = 1e-3;  // [s]
 // when its slip exceeds 1% of L_ref.
 constexpr double kHingeFraction = 0.01;
 
+// At rest: the largest free-node speed has stayed below v_rest for the hold window, and the
+// kinetic energy is not growing over it (its peak over the second half of the window is no
+// larger than over the first half). The second condition tells a decaying oscillation from a
+// mechanism that has just started to move and is still slow.
+class RestDetector {
+ public:
+  RestDetector(double v_rest, double hold) : v_rest_(v_rest), hold_(hold) {}
+  bool update(double t, double v_max, double kinetic) {
+    if (v_max >= v_rest_) {
+      window_.clear();
+      return false;
+    }
+    window_.push_back({t, kinetic});
+    const double t0 = window_.front().t;
+    if (t - t0 < hold_) return false;
+    const double mid = t0 + 0.5 * (t - t0);
+    double first = 0.0, second = 0.0;
+    for (const Sample& s : window_) {
+      double& peak = s.t <= mid ? first : second;
+      peak = std::max(peak, s.kinetic);
+    }
+    if (second <= first) return true;
+    // Growing: keep watching the second half.
+    while (!window_.empty() && window_.front().t <= mid) window_.erase(window_.begin());
+    return false;
+  }
+
+ private:
+  struct Sample {
+    double t, kinetic;
+  };
+  double v_rest_, hold_;
+  std::vector<Sample> window_;
+};
+
 }  // namespace
 
 SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet) {
@@ -58,7 +93,7 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   const double dt = sim.ctx.dt;
   const long long every = std::max(1LL, std::llround(kSampleTime / dt));
   const double v_rest = crit.rest_speed * std::sqrt(std::max(s.gravity, 1e-12) * s.l_ref);
-  double rest_since = -1.0;
+  RestDetector rest(v_rest, crit.hold_time);
   while (sim.ctx.time < crit.settle_max_time) {
     const double ramp = std::min(1.0, sim.ctx.time / crit.ramp_time);
     set_static_load(sim, s.gravity * ramp, 0.0);
@@ -66,14 +101,9 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
     if (sim.step % every != 0) continue;
     check_finite(sim);
     if (sim.ctx.time < crit.ramp_time) continue;
-    if (max_free_speed(sim.model.nodes) < v_rest) {
-      if (rest_since < 0.0) rest_since = sim.ctx.time;
-      if (sim.ctx.time - rest_since >= crit.hold_time) {
-        s.settled = true;
-        break;
-      }
-    } else {
-      rest_since = -1.0;
+    if (rest.update(sim.ctx.time, max_free_speed(sim.model.nodes), sim.ledger.kinetic)) {
+      s.settled = true;
+      break;
     }
   }
   set_static_load(sim, s.gravity, 0.0);
@@ -100,7 +130,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
 
   TrialResult r;
   r.lambda = lambda;
-  double rest_since = -1.0;
+  RestDetector rest(v_rest, crit.hold_time);
   // Motion measure m(t) = max over blocks of max(d / d_collapse, |rotation| / rot_collapse)
   // (1 = collapse) sampled in time, for the timeout decision.
   std::vector<double> measure;
@@ -128,14 +158,9 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
       decided = true;
     } else if (elapsed >= crit.ramp_time) {
       const double v = max_free_speed(sim.model.nodes);
-      if (v < v_rest) {
-        if (rest_since < 0.0) rest_since = elapsed;
-        if (elapsed - rest_since >= crit.hold_time) {
-          r.reason = "rest";
-          decided = true;
-        }
-      } else {
-        rest_since = -1.0;
+      if (rest.update(elapsed, v, sim.ledger.kinetic)) {
+        r.reason = "rest";
+        decided = true;
       }
       if (!decided && elapsed >= crit.max_time) {
         // Near lambda* the restoring stiffness of the mechanism vanishes, so motion decays
@@ -157,6 +182,8 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   if (r.collapsed) {
     const double tol = kHingeFraction * settled.l_ref;
     r.hinges = find_hinges(sim.model, tol, tol);
+    r.final_x = sim.model.nodes.x;
+    r.final_y = sim.model.nodes.y;
   }
   r.wall_s = seconds_since(t0);
   return r;
@@ -472,8 +499,16 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       if (!r.collapsed && r.lambda < hi) lo = std::max(lo, r.lambda);
     if (!quiet) std::fprintf(stderr, "bracket [%.5f, %.5f]\n", lo, hi);
   }
-  for (const TrialResult& r : res.trials)
-    if (r.collapsed && r.lambda == hi) res.hinges = r.hinges;
+  for (const TrialResult& r : res.trials) {
+    if (!r.collapsed || r.lambda != hi) continue;
+    res.hinges = r.hinges;
+    if (!r.final_x.empty()) {
+      res.has_mode = true;
+      res.mode = settled.sim.model;
+      res.mode.nodes.x = r.final_x;
+      res.mode.nodes.y = r.final_y;
+    }
+  }
   res.lo = lo;
   res.hi = hi;
   res.lambda_star = 0.5 * (lo + hi);

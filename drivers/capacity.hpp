@@ -13,7 +13,9 @@
 //        `collapse_displacement` x L_ref or rotated more than `collapse_rotation` since the
 //        settled state (L_ref: square root of the smallest free block area);
 //      stable as soon as, after the ramp, the largest free-node speed has stayed below
-//        `rest_speed` x sqrt(g L_ref) for `hold_time` without interruption;
+//        `rest_speed` x sqrt(g L_ref) for `hold_time` without interruption and the kinetic
+//        energy has not grown over that window (peak of its second half <= peak of its first:
+//        a decaying oscillation, not a mechanism that has just started and is still slow);
 //      when neither happens by `max_time`, the trial is collapsed if the block motion is still
 //      growing (speed above the rest threshold), stable otherwise (reported as "timeout").
 // The thresholds are studied in docs/capacity.md.
@@ -37,8 +39,8 @@ struct TrialCriteria {
   double ramp_time = 0.1;              // [s] load ramp (gravity when settling, lambda g after)
   double collapse_displacement = 0.05; // x L_ref
   double collapse_rotation = 0.05;     // [rad]
-  double rest_speed = 1e-4;            // x sqrt(g L_ref)
-  double hold_time = 0.05;             // [s]
+  double rest_speed = 1e-3;            // x sqrt(g L_ref)
+  double hold_time = 0.1;              // [s]
   double max_time = 3.0;               // [s] of simulated time after settling
   double settle_max_time = 2.0;        // [s]
 };
@@ -54,6 +56,7 @@ struct TrialResult {
   double max_rotation = 0.0;           // largest block rotation [rad]
   double energy_balance_error = 0.0;
   std::vector<Hinge> hinges;           // joints opened or slid at the end of the trial
+  std::vector<double> final_x, final_y;  // node positions at the end (collapsed trials only)
 };
 
 struct SettledState {
@@ -110,6 +113,10 @@ struct CapacityResult {
   bool bracketed = false;              // false when no collapse was found up to the cap
   SeedReport seed;
   int resumed_trials = 0;              // trials taken from the journal
+  // The model at the end of the collapsed trial closest to lambda* (the failure mode), when
+  // that trial ran in this process (not taken from a journal).
+  bool has_mode = false;
+  Model mode;
 };
 
 // Bisection for lambda*; progress lines on stderr unless quiet.

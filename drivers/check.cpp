@@ -38,6 +38,32 @@ nlohmann::json model_geometry_json(const Model& model) {
           {"tri_block", tri_block}, {"blocks", blocks}, {"joints", joints}};
 }
 
+nlohmann::json failure_mode_json(const Model& model, const std::vector<Hinge>& hinges) {
+  using nlohmann::json;
+  json geo = model_geometry_json(model);
+  const std::vector<BlockMotion> motions = block_motions(model);
+  json reference = json::array();
+  for (size_t b = 0; b < model.blocks.size(); ++b) {
+    json moved = json::array(), ref = json::array();
+    for (const Vec2& p : model.blocks[b].polygon) {
+      const Vec2 q = move_point(motions[b], p);
+      moved.push_back({q.x, q.y});
+      ref.push_back({p.x, p.y});
+    }
+    geo["blocks"][b]["polygon"] = moved;
+    reference.push_back(ref);
+  }
+  geo["reference_blocks"] = reference;
+  json marks = hinges_to_json(hinges);
+  for (size_t k = 0; k < hinges.size(); ++k) {
+    const Vec2 q = move_point(motions[hinges[k].block_a], Vec2{hinges[k].x, hinges[k].y});
+    marks[k]["x_deformed"] = q.x;
+    marks[k]["y_deformed"] = q.y;
+  }
+  geo["hinges"] = marks;
+  return geo;
+}
+
 int command_check(const Config& config, const CommonOptions& common, const CheckOptions& opts) {
   SetupInfo info;
   Simulation sim = make_simulation(config, &info);

@@ -1,6 +1,7 @@
 // `voussoir capacity DECK`: lambda* by k-section bisection, with every trial in the JSON.
 
 #include <cstdio>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 
 #include "drivers/capacity.hpp"
@@ -9,7 +10,7 @@
 
 namespace voussoir {
 
-nlohmann::json hinges_json(const std::vector<Hinge>& hinges) {
+nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
   nlohmann::json out = nlohmann::json::array();
   for (const Hinge& h : hinges)
     out.push_back({{"joint", h.joint},
@@ -50,6 +51,27 @@ int command_capacity(const Config& config, const CommonOptions& common,
                 h.block_a, h.block_b, h.position_deg, h.side.empty() ? "" : ", pivot at ",
                 h.side.c_str());
 
+  if ((!opts.mode_out.empty() || !opts.picture.empty()) && !res.has_mode)
+    std::fprintf(stderr, "voussoir: no failure-mode picture: %s\n",
+                 res.bracketed ? "the collapsed trial came from the journal" : "no collapse found");
+  if (res.has_mode) {
+    const nlohmann::json mode = failure_mode_json(res.mode, res.hinges);
+    if (!opts.mode_out.empty()) write_json(mode, opts.mode_out);
+    if (!opts.picture.empty()) {
+      const std::string tmp = opts.picture + ".mode.json";
+      write_json(mode, tmp);
+      char title[160];
+      std::snprintf(title, sizeof title, "failure mode at lambda = %.4f (lambda* = %.4f)", res.hi,
+                    res.lambda_star);
+      const std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
+                              "/scripts/draw '" + tmp + "' -o '" + opts.picture +
+                              "' --no-mesh --title '" + title + "'";
+      if (std::system(cmd.c_str()) != 0)
+        std::fprintf(stderr, "voussoir: warning: the picture %s could not be drawn\n",
+                     opts.picture.c_str());
+      std::remove(tmp.c_str());
+    }
+  }
   if (!common.json_path.empty()) {
     nlohmann::json runs = nlohmann::json::array();
     for (const TrialResult& r : res.trials)
@@ -71,7 +93,7 @@ int command_capacity(const Config& config, const CommonOptions& common,
                         {"dt", res.dt},
                         {"wall_s", res.wall_s},
                         {"points_per_round", opts.points},
-                        {"hinges", hinges_json(res.hinges)},
+                        {"hinges", hinges_to_json(res.hinges)},
                         {"resumed_trials", res.resumed_trials},
                         {"seed",
                          {{"used", res.seed.used},

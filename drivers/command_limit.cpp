@@ -18,7 +18,6 @@
 namespace voussoir {
 
 // Meshed model geometry as written by `voussoir check --mesh-out` (drivers/check.cpp).
-nlohmann::json model_geometry_json(const Model& model);
 
 namespace {
 

@@ -254,18 +254,22 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   }
   const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
 
+  // Peak of the unit-amplitude pulse (0.891 for the 3-cycle windowed sine, 1 for one sine):
+  // the quasi-static limit of the curve is A = lambda* / peak_factor.
+  const double peak_factor = make_base_signal(config.load.base, 1.0, 1.0, 1.0).peak_acceleration();
   const std::string csv_path = opts.csv.empty() ? "curve.csv" : opts.csv;
   {
     std::ofstream csv(csv_path);
     if (!csv) throw OutputError(csv_path + ": cannot write the curve CSV");
     csv << "frequency,amplitude,lo,hi,bracketed,trials,wall_s,max_energy_balance_error,"
-           "lambda_star,error\n";
+           "lambda_star,peak_factor,error\n";
     csv.precision(8);
     for (size_t i = 0; i < points.size(); ++i) {
       const CurvePoint& p = points[i];
       csv << p.frequency << "," << p.amplitude << "," << p.lo << "," << p.hi << ","
           << (p.bracketed ? 1 : 0) << "," << p.trials << "," << p.wall_s << ","
-          << p.max_energy_balance_error << "," << lambda_star << ",\"" << errors[i] << "\"\n";
+          << p.max_energy_balance_error << "," << lambda_star << "," << peak_factor << ",\""
+          << errors[i] << "\"\n";
     }
   }
   std::printf("lambda* = %.4f (tilting capacity, low-frequency asymptote)\n", lambda_star);
@@ -313,6 +317,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
     }
     nlohmann::json j = {{"curve", curve},
                         {"lambda_star", lambda_star},
+                        {"peak_factor", peak_factor},
                         {"lambda_star_computed", opts.lambda_star < 0.0},
                         {"capacity_wall_s", capacity_wall},
                         {"signal", config.load.base.signal},

@@ -6,6 +6,10 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "core/model.hpp"
+#include "drivers/kinematics.hpp"
 #include "io/config.hpp"
 
 namespace voussoir {
@@ -19,6 +23,17 @@ struct CommonOptions {
 struct CheckOptions {
   std::string mesh_out;      // --mesh-out FILE: model geometry as JSON (for scripts/draw)
 };
+
+// The meshed model as JSON for scripts/draw: nodes (current positions), triangles, tri_block,
+// blocks (fixed, role, polygon), joints.
+nlohmann::json model_geometry_json(const Model& model);
+
+// The deformed model for pictures of a failure mode: model_geometry_json of the current state
+// with every block outline moved by its rigid motion, the reference outlines under
+// "reference_blocks", and the hinges (pivot moved with its block) under "hinges".
+nlohmann::json failure_mode_json(const Model& model, const std::vector<Hinge>& hinges);
+
+nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges);
 
 int command_check(const Config& config, const CommonOptions& common, const CheckOptions& opts);
 
@@ -47,6 +62,8 @@ struct CapacityOptions {
   int points = 2;            // trial lambdas per bisection round (k-section with k = points+1)
   bool no_seed = false;      // --no-seed: do not start from the limit-analysis bracket
   std::string resume;        // --resume FILE: journal of finished trials (created if absent)
+  std::string mode_out;      // --mode-out FILE.json: deformed state of the collapse with hinges
+  std::string picture;       // --picture FILE.png|svg: the same drawn by scripts/draw
 };
 
 int command_capacity(const Config& config, const CommonOptions& common,

@@ -119,7 +119,8 @@ LoopStats run_loop(Simulation& sim, const LoopOptions& opts,
     const bool last = sim.step == total_steps;
     if (sim.step % every == 0 || last) {
       check_finite(sim);
-      if (opts.drift_limit > 0.0) check_energy_balance(sim, opts.drift_limit);
+      if (opts.drift_limit > 0.0 && sim.step >= opts.drift_arm_steps)
+        check_energy_balance(sim, opts.drift_limit);
       go_on = sample(sim);
       const auto now = clock::now();
       if (!opts.quiet && std::chrono::duration<double>(now - last_report).count() > 2.0) {

@@ -28,6 +28,8 @@ namespace voussoir {
 // Largest balance error of the energy ledger a run may reach (dimensionless, relative to the
 // peak energy; see above).
 inline constexpr double kEnergyDriftLimit = 0.05;
+// Steps after which the energy guard is armed (see above).
+inline constexpr long long kEnergyDriftArmSteps = 1000;
 
 // Largest displacement magnitude of any free node from its reference position [m].
 double max_free_displacement(const Model& model);
@@ -52,6 +54,7 @@ struct LoopOptions {
   bool quiet = false;                      // no progress on stderr
   std::string label = "run";               // progress line prefix
   double drift_limit = kEnergyDriftLimit;  // <= 0: energy guard off
+  long long drift_arm_steps = kEnergyDriftArmSteps;  // guard checked from this step on
   // Checkpoints: `checkpoint(sim, stats)` after every `checkpoint_every` seconds of simulated
   // time (rounded to whole steps, at least one; 0 = never), after that step's sample if it has
   // one, never after the last step.

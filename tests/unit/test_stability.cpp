@@ -114,6 +114,11 @@ Figures run_case(const std::string& name, Simulation& sim, double dt_stable, dou
       f.finite = false;
       return false;
     }
+    if (getenv("VTRACE") && s.step % 500 == 0) std::printf("  trace t %.4e step %lld err %.3e peak %.3e C %.3e\n", s.ctx.time, s.step, s.ledger.balance_error(), s.ledger.max_energy, s.ledger.contact);
+    if (s.ledger.balance_error() > f.max_error) {
+      const EnergyLedger& l = s.ledger;
+      if (getenv("VDEBUG")) std::printf("  t %.4e step %lld err %.3e W %.4e K %.4e U %.4e C %.4e Dd %.4e Df %.4e max %.4e\n", s.ctx.time, s.step, l.balance_error(), l.external_work, l.kinetic, l.strain, l.contact, l.damping_dissipated, l.friction_dissipated, l.max_energy);
+    }
     f.max_error = std::max(f.max_error, s.ledger.balance_error());
     return true;
   };
@@ -500,3 +505,44 @@ TEST(Guards, FailedRunLeavesItsOutputMarkedIncomplete) {
 
 }  // namespace
 }  // namespace voussoir
+#include "contact/narrow_phase.hpp"
+namespace voussoir { namespace {
+TEST(Diag, NegativeContactEnergy) {
+  if (!getenv("VDEBUG")) GTEST_SKIP();
+  const Config config = arch_deck({"material.young=200e9"});
+  Built b = build(config);
+  Simulation& sim = b.sim;
+  const Model& m = sim.model;
+  for (int s = 0; s < 6; ++s) {
+    const Nodes& n = m.nodes; const Triangles& t = m.tris;
+    auto tri = [&](Index e) { return std::array<Vec2,3>{Vec2{n.x[t.n0[e]], n.y[t.n0[e]]}, Vec2{n.x[t.n1[e]], n.y[t.n1[e]]}, Vec2{n.x[t.n2[e]], n.y[t.n2[e]]}}; };
+    double tot = 0; int neg = 0;
+    for (Index a = 0; a < t.size(); ++a) for (Index c = a+1; c < t.size(); ++c) {
+      if (t.block[a] == t.block[c]) continue;
+      if (m.blocks[t.block[a]].fixed && m.blocks[t.block[c]].fixed) continue;
+      if (!t.boundary[a] || !t.boundary[c]) continue;
+      const PairForce f = triangle_pair_force(tri(a), tri(c), sim.contact.penalty() * m.out_of_plane);
+      tot += f.energy;
+      if (f.energy < 0 && neg++ < 3) {
+        std::printf("  pair %d %d area %.6e energy %.6e\n", a, c, f.area, f.energy);
+        for (auto T : {tri(a), tri(c)}) std::printf("    {{%.17g, %.17g}, {%.17g, %.17g}, {%.17g, %.17g}}\n", T[0].x, T[0].y, T[1].x, T[1].y, T[2].x, T[2].y);
+      }
+    }
+    advance(sim);
+    std::printf("step %lld ledger C %.6e brute-force before the step %.6e (negative pairs %d)\n", sim.step, sim.ledger.contact, tot, neg);
+  }
+}
+}}
+
+namespace voussoir { namespace {
+TEST(Diag, BlowUp) {
+  if (!getenv("VDEBUG")) GTEST_SKIP();
+  for (double factor : {1.05, 1.1, 1.2, 1.5, 2.0, 3.0}) {
+    Built b = unstable_block(factor);
+    LoopOptions opts; opts.end_time = 0.05; opts.sample_every = b.sim.ctx.dt; opts.quiet = true;
+    std::string msg = "none";
+    try { run_loop(b.sim, opts, [&](const Simulation&) { return true; }); } catch (const RunError& e) { msg = e.what(); }
+    std::printf("factor %.2f: %s\n", factor, msg.substr(0, 120).c_str());
+  }
+}
+}}
