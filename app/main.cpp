@@ -80,6 +80,22 @@ int main(int argc, char** argv) {
                        "JSON of the deformed collapse state with its hinges");
   capacity->add_option("--picture", cap_opts.picture,
                        "picture (PNG/SVG) of the failure mode with hinges marked");
+  // Trial criteria (defaults and their study: docs/capacity.md).
+  capacity->add_option("--ramp-time", cap_opts.criteria.ramp_time, "load ramp [s]")
+      ->check(CLI::PositiveNumber);
+  capacity->add_option("--collapse-displacement", cap_opts.criteria.collapse_displacement,
+                       "collapse when a block moves this x L_ref")
+      ->check(CLI::PositiveNumber);
+  capacity->add_option("--collapse-rotation", cap_opts.criteria.collapse_rotation,
+                       "collapse when a block rotates this [rad]")
+      ->check(CLI::PositiveNumber);
+  capacity->add_option("--rest-speed", cap_opts.criteria.rest_speed,
+                       "at rest below this x sqrt(g L_ref)")
+      ->check(CLI::PositiveNumber);
+  capacity->add_option("--hold-time", cap_opts.criteria.hold_time, "rest hold window [s]")
+      ->check(CLI::PositiveNumber);
+  capacity->add_option("--max-time", cap_opts.criteria.max_time, "trial time limit [s]")
+      ->check(CLI::PositiveNumber);
 
   voussoir::LimitCommandOptions limit_opts;
   CLI::App* limit =

@@ -73,6 +73,9 @@ struct ContactSystem::Impl {
   // Candidate pairs (triangle ids, sorted) and their friction state.
   std::vector<IndexPair> pairs, next_pairs;
   std::vector<double> sx, sy, kt, next_sx, next_sy;
+  // Nodes of each pair's two triangles (c = pairs[p].a, t = pairs[p].b), filled at detection
+  // so that the per-step loop reads one flat array per corner instead of pairs -> tris -> nodes.
+  std::vector<Index> pc0, pc1, pc2, pt0, pt1, pt2;
 
   // Per triangle id (participants only): longest boundary edge [m] and the height over it [m].
   std::vector<double> edge_len, height;
@@ -85,7 +88,7 @@ struct ContactSystem::Impl {
   std::vector<PairResult> results;  // per-pair slots of the multi-threaded path
 
   template <bool kFriction>
-  PairResult evaluate(std::size_t p, const Nodes& n, const Triangles& t, double dt);
+  bool evaluate(std::size_t p, const Nodes& n, double dt, PairResult& r);
   template <bool kFriction>
   void accumulate(Model& model, double dt, EnergyLedger& ledger);
 };
@@ -152,48 +155,89 @@ void ContactSystem::detect(const Model& model) {
   std::swap(s.pairs, s.next_pairs);
   std::swap(s.sx, s.next_sx);
   std::swap(s.sy, s.next_sy);
-  s.kt.resize(s.pairs.size());
+  const std::size_t np = s.pairs.size();
+  s.kt.resize(np);
+  for (auto* v : {&s.pc0, &s.pc1, &s.pc2, &s.pt0, &s.pt1, &s.pt2}) v->resize(np);
+  const Triangles& t = model.tris;
   const double scale = kTangentialStiffnessRatio * s.penalty * s.thickness;
-  for (std::size_t p = 0; p < s.pairs.size(); ++p) {
+  for (std::size_t p = 0; p < np; ++p) {
     const Index a = s.pairs[p].a, b = s.pairs[p].b;
+    s.pc0[p] = t.n0[a], s.pc1[p] = t.n1[a], s.pc2[p] = t.n2[a];
+    s.pt0[p] = t.n0[b], s.pt1[p] = t.n1[b], s.pt2[p] = t.n2[b];
     s.kt[p] =
         scale * (3.0 / s.height[a] + 3.0 / s.height[b]) * std::min(s.edge_len[a], s.edge_len[b]);
   }
   ++s.detections;
 }
 
+namespace {
+
+inline double min3(double a, double b, double c) {
+  return std::min(a, std::min(b, c));
+}
+inline double max3(double a, double b, double c) {
+  return std::max(a, std::max(b, c));
+}
+
+// True when one edge line of triangle A (counter-clockwise) has all three vertices of B on its
+// outer side or on it: cross(A_j - A_i, B_v - A_i) <= 0 for v = 0, 1, 2.
+inline bool outside_an_edge(const double* ax, const double* ay, const double* bx,
+                            const double* by) {
+  for (int i = 0; i < 3; ++i) {
+    const int j = i == 2 ? 0 : i + 1;
+    const double ex = ax[j] - ax[i], ey = ay[j] - ay[i];
+    const double e0 = ex * (by[0] - ay[i]) - ey * (bx[0] - ax[i]);
+    const double e1 = ex * (by[1] - ay[i]) - ey * (bx[1] - ax[i]);
+    const double e2 = ex * (by[2] - ay[i]) - ey * (bx[2] - ax[i]);
+    if (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+// One pair: false when it does not touch (friction history cleared), else r filled.
+//
+// Rejection before the kernel, in two steps. (1) The current, uninflated bounding boxes.
+// (2) Separating axes: the six edge lines of the two triangles, in the kernel's local
+// coordinates (origin at c's first vertex). When all vertices of one triangle lie outside
+// (or on) one edge line of the other, the overlap has no area and triangle_pair_force would
+// return zero after clipping, so skipping it changes no result. On the settled 48-triangle
+// arch 55 of the 82 candidate pairs pass the boxes each step and only 12 overlap; the test
+// costs ~60 instructions against ~550 for a rejected kernel call (callgrind).
 template <bool kFriction>
-inline PairResult ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, const Triangles& t,
-                                                double dt) {
-  PairResult r;
+inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double dt, PairResult& r) {
   const double* x = n.x.data();
   const double* y = n.y.data();
-  const Index a = pairs[p].a, b = pairs[p].b;
-  const Index c[3] = {t.n0[a], t.n1[a], t.n2[a]};
-  const Index d[3] = {t.n0[b], t.n1[b], t.n2[b]};
-  // Quick rejection on the current (uninflated) boxes.
-  const double cxl = std::min({x[c[0]], x[c[1]], x[c[2]]});
-  const double cxh = std::max({x[c[0]], x[c[1]], x[c[2]]});
-  const double dxl = std::min({x[d[0]], x[d[1]], x[d[2]]});
-  const double dxh = std::max({x[d[0]], x[d[1]], x[d[2]]});
-  const double cyl = std::min({y[c[0]], y[c[1]], y[c[2]]});
-  const double cyh = std::max({y[c[0]], y[c[1]], y[c[2]]});
-  const double dyl = std::min({y[d[0]], y[d[1]], y[d[2]]});
-  const double dyh = std::max({y[d[0]], y[d[1]], y[d[2]]});
-  if (!(cxl < dxh && dxl < cxh && cyl < dyh && dyl < cyh)) {
-    if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
-    return r;
+  const Index c[3] = {pc0[p], pc1[p], pc2[p]};
+  const Index d[3] = {pt0[p], pt1[p], pt2[p]};
+  const double cxa[3] = {x[c[0]], x[c[1]], x[c[2]]}, cya[3] = {y[c[0]], y[c[1]], y[c[2]]};
+  const double txa[3] = {x[d[0]], x[d[1]], x[d[2]]}, tya[3] = {y[d[0]], y[d[1]], y[d[2]]};
+  bool apart = !(min3(cxa[0], cxa[1], cxa[2]) < max3(txa[0], txa[1], txa[2]) &&
+                 min3(txa[0], txa[1], txa[2]) < max3(cxa[0], cxa[1], cxa[2]) &&
+                 min3(cya[0], cya[1], cya[2]) < max3(tya[0], tya[1], tya[2]) &&
+                 min3(tya[0], tya[1], tya[2]) < max3(cya[0], cya[1], cya[2]));
+  if (!apart) {
+    const double ox = cxa[0], oy = cya[0];
+    const double lcx[3] = {0.0, cxa[1] - ox, cxa[2] - ox}, lcy[3] = {0.0, cya[1] - oy, cya[2] - oy};
+    const double ltx[3] = {txa[0] - ox, txa[1] - ox, txa[2] - ox};
+    const double lty[3] = {tya[0] - oy, tya[1] - oy, tya[2] - oy};
+    apart = outside_an_edge(lcx, lcy, ltx, lty) || outside_an_edge(ltx, lty, lcx, lcy);
   }
-  const PairForce f =
-      triangle_pair_force({Vec2{x[c[0]], y[c[0]]}, Vec2{x[c[1]], y[c[1]]}, Vec2{x[c[2]], y[c[2]]}},
-                          {Vec2{x[d[0]], y[d[0]]}, Vec2{x[d[1]], y[d[1]]}, Vec2{x[d[2]], y[d[2]]}},
-                          penalty * thickness);
+  if (apart) {
+    if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
+    return false;
+  }
+  const PairForce f = triangle_pair_force(
+      {Vec2{cxa[0], cya[0]}, Vec2{cxa[1], cya[1]}, Vec2{cxa[2], cya[2]}},
+      {Vec2{txa[0], tya[0]}, Vec2{txa[1], tya[1]}, Vec2{txa[2], tya[2]}}, penalty * thickness);
   if (!(f.area > 0.0)) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;
-    return r;
+    return false;
   }
-  r.active = true;
   r.energy = f.energy;
+  r.stored = 0.0;
+  r.dissipated = 0.0;
   for (int k = 0; k < 3; ++k) {
     r.on_c[k] = f.on_c[k];
     r.on_t[k] = f.on_t[k];
@@ -220,28 +264,25 @@ inline PairResult ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, c
     r.stored = fr.stored;
     r.dissipated = fr.dissipated;
   }
-  return r;
+  return true;
 }
 
 template <bool kFriction>
 void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledger) {
   Nodes& n = model.nodes;
-  const Triangles& t = model.tris;
   double* fx = n.fx.data();
   double* fy = n.fy.data();
   double energy = 0.0, stored = 0.0, dissipated = 0.0;
   std::int64_t n_active = 0;
-  // Adds one pair's result; always called in pair order, so the sums are the same whatever
-  // the number of threads that evaluated the pairs.
+  // Adds one touching pair's result; always called in pair order, so the sums are the same
+  // whatever the number of threads that evaluated the pairs.
   auto apply = [&](std::size_t p, const PairResult& r) {
-    if (!r.active) return;
     ++n_active;
     energy += r.energy;
     stored += r.stored;
     dissipated += r.dissipated;
-    const Index a = pairs[p].a, b = pairs[p].b;
-    const Index c[3] = {t.n0[a], t.n1[a], t.n2[a]};
-    const Index d[3] = {t.n0[b], t.n1[b], t.n2[b]};
+    const Index c[3] = {pc0[p], pc1[p], pc2[p]};
+    const Index d[3] = {pt0[p], pt1[p], pt2[p]};
     for (int k = 0; k < 3; ++k) {
       fx[c[k]] += r.on_c[k].x;
       fy[c[k]] += r.on_c[k].y;
@@ -256,10 +297,14 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
     results.resize(np);
     const std::int64_t count = static_cast<std::int64_t>(np);
 #pragma omp parallel for schedule(static)
-    for (std::int64_t p = 0; p < count; ++p) results[p] = evaluate<kFriction>(p, n, t, dt);
-    for (std::size_t p = 0; p < np; ++p) apply(p, results[p]);
+    for (std::int64_t p = 0; p < count; ++p)
+      results[p].active = evaluate<kFriction>(p, n, dt, results[p]);
+    for (std::size_t p = 0; p < np; ++p)
+      if (results[p].active) apply(p, results[p]);
   } else {
-    for (std::size_t p = 0; p < np; ++p) apply(p, evaluate<kFriction>(p, n, t, dt));
+    PairResult r;
+    for (std::size_t p = 0; p < np; ++p)
+      if (evaluate<kFriction>(p, n, dt, r)) apply(p, r);
   }
   active = n_active;
   ledger.contact = energy + stored;

@@ -27,7 +27,7 @@ nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
 
 int command_capacity(const Config& config, const CommonOptions& common,
                      const CapacityOptions& opts) {
-  const TrialCriteria criteria;
+  const TrialCriteria& criteria = opts.criteria;
   CapacitySearch search;
   search.points = opts.points;
   search.quiet = common.quiet;

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/model.hpp"
+#include "drivers/capacity.hpp"
 #include "drivers/kinematics.hpp"
 #include "io/config.hpp"
 
@@ -64,6 +65,7 @@ struct CapacityOptions {
   std::string resume;        // --resume FILE: journal of finished trials (created if absent)
   std::string mode_out;      // --mode-out FILE.json: deformed state of the collapse with hinges
   std::string picture;       // --picture FILE.png|svg: the same drawn by scripts/draw
+  TrialCriteria criteria;    // --ramp-time, --rest-speed, ... (docs/capacity.md)
 };
 
 int command_capacity(const Config& config, const CommonOptions& common,

@@ -77,6 +77,12 @@ std::vector<JointState> joint_states(const Model& model, const std::vector<Block
 std::vector<Hinge> find_hinges(const Model& model, double open_tol, double slip_tol) {
   const auto motions = block_motions(model);
   const auto states = joint_states(model, motions);
+  // Joints of one mechanism open at different rates (the springing hinge of an arch opens
+  // less than the crown one): a joint counts when its gap reaches `open_tol` or a quarter of
+  // the largest gap of the model, whichever is smaller, but never below open_tol / 10.
+  double largest = 0.0;
+  for (const JointState& s : states) largest = std::max({largest, s.opening_a, s.opening_b});
+  open_tol = std::max(0.1 * open_tol, std::min(open_tol, 0.25 * largest));
   std::vector<Hinge> out;
   for (const JointState& s : states) {
     const Joint& jt = model.joints[s.joint];

@@ -62,7 +62,7 @@ void check_finite(const Simulation& sim) {
   const Nodes& n = sim.model.nodes;
   for (Index i = 0; i < n.size(); ++i) {
     if (std::isfinite(n.x[i]) && std::isfinite(n.y[i]) && std::isfinite(n.vx[i]) &&
-        std::isfinite(n.vy[i]))
+        std::isfinite(n.vy[i]) && std::isfinite(n.fx[i]) && std::isfinite(n.fy[i]))
       continue;
     throw RunError("non-finite state " + where(sim, i) +
                    " (the time step may be too large for the contact penalty; try a smaller "
@@ -70,7 +70,7 @@ void check_finite(const Simulation& sim) {
   }
   const EnergyLedger& l = sim.ledger;
   for (const double e : {l.kinetic, l.strain, l.contact, l.external_work, l.damping_dissipated,
-                         l.friction_dissipated}) {
+                         l.friction_dissipated, l.max_energy}) {
     if (std::isfinite(e)) continue;
     throw RunError("non-finite energy " + where(sim, fastest_node(n)) +
                    " (the fastest node; the loads or the material may be out of range)");

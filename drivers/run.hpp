@@ -4,8 +4,8 @@
 // report progress.
 //
 // Guards (SPEC.md section 2: "no NaN silently written"; docs/robustness.md). At every sample:
-//   - non-finite: any node position or velocity, or any term of the energy ledger, that is
-//     NaN or infinite stops the run (check_finite);
+//   - non-finite: any node position, velocity or force, or any term of the energy ledger,
+//     that is NaN or infinite stops the run (check_finite);
 //   - energy drift: the ledger's balance error |W - K - U - C - D| / (peak energy) above
 //     kEnergyDriftLimit stops the run (check_energy_balance). The central-difference ledger
 //     of core/step.cpp is exact for linear systems and O(dt^2) otherwise: the stiff and
@@ -34,8 +34,8 @@ inline constexpr long long kEnergyDriftArmSteps = 1000;
 // Largest displacement magnitude of any free node from its reference position [m].
 double max_free_displacement(const Model& model);
 
-// Throws RunError naming the step, time, block and triangle when any node position or velocity
-// or any energy of the ledger is not finite.
+// Throws RunError naming the step, time, block and triangle when any node position, velocity
+// or force, or any energy of the ledger, is not finite.
 void check_finite(const Simulation& sim);
 
 // Throws RunError naming the step, time and the fastest node (its block and a triangle) when

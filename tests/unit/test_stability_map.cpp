@@ -79,7 +79,7 @@ TEST(StabilityGrid, ThicknessRatioScalesWithRadius) {
 
 TEST(StabilityCell, ThickArchStandsThinArchFalls) {
   const StabilityCriteria crit = fast_criteria();
-  const StabilityCell thick = run_stability_cell(arch(0.25, 0.8), crit, false);
+  StabilityCell thick = run_stability_cell(arch(0.25, 0.8), crit, false);
   EXPECT_TRUE(thick.stable) << thick.reason;
   EXPECT_EQ(thick.reason, "rest");
   EXPECT_LT(thick.max_displacement, crit.trial.collapse_displacement * thick.l_ref);
@@ -103,7 +103,9 @@ TEST(StabilityCell, ThickArchStandsThinArchFalls) {
     for (size_t k = 0; k < thin.outlines[b].size(); ++k) {
       const double d = std::hypot(thin.outlines[b][k].x - thin.outlines0[b][k].x,
                                   thin.outlines[b][k].y - thin.outlines0[b][k].y);
-      if (thin.fixed[b]) EXPECT_EQ(d, 0.0);
+      if (thin.fixed[b]) {
+        EXPECT_EQ(d, 0.0);
+      }
       moved = std::max(moved, d);
     }
   EXPECT_GT(moved, crit.trial.collapse_displacement * thin.l_ref);
