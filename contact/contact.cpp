@@ -36,6 +36,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -179,21 +180,6 @@ inline double max3(double a, double b, double c) {
   return std::max(a, std::max(b, c));
 }
 
-// True when one edge line of triangle A (counter-clockwise) has all three vertices of B on its
-// outer side or on it: cross(A_j - A_i, B_v - A_i) <= 0 for v = 0, 1, 2.
-inline bool outside_an_edge(const double* ax, const double* ay, const double* bx,
-                            const double* by) {
-  for (int i = 0; i < 3; ++i) {
-    const int j = i == 2 ? 0 : i + 1;
-    const double ex = ax[j] - ax[i], ey = ay[j] - ay[i];
-    const double e0 = ex * (by[0] - ay[i]) - ey * (bx[0] - ax[i]);
-    const double e1 = ex * (by[1] - ay[i]) - ey * (bx[1] - ax[i]);
-    const double e2 = ex * (by[2] - ay[i]) - ey * (bx[2] - ax[i]);
-    if (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 // One pair: false when it does not touch (friction history cleared), else r filled.
@@ -217,20 +203,14 @@ inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double 
                  min3(txa[0], txa[1], txa[2]) < max3(cxa[0], cxa[1], cxa[2]) &&
                  min3(cya[0], cya[1], cya[2]) < max3(tya[0], tya[1], tya[2]) &&
                  min3(tya[0], tya[1], tya[2]) < max3(cya[0], cya[1], cya[2]));
-  if (!apart) {
-    const double ox = cxa[0], oy = cya[0];
-    const double lcx[3] = {0.0, cxa[1] - ox, cxa[2] - ox}, lcy[3] = {0.0, cya[1] - oy, cya[2] - oy};
-    const double ltx[3] = {txa[0] - ox, txa[1] - ox, txa[2] - ox};
-    const double lty[3] = {tya[0] - oy, tya[1] - oy, tya[2] - oy};
-    apart = outside_an_edge(lcx, lcy, ltx, lty) || outside_an_edge(ltx, lty, lcx, lcy);
-  }
+  const std::array<Vec2, 3> cv{Vec2{cxa[0], cya[0]}, Vec2{cxa[1], cya[1]}, Vec2{cxa[2], cya[2]}};
+  const std::array<Vec2, 3> tv{Vec2{txa[0], tya[0]}, Vec2{txa[1], tya[1]}, Vec2{txa[2], tya[2]}};
+  apart = apart || triangles_separated(cv, tv);
   if (apart) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
     return false;
   }
-  const PairForce f = triangle_pair_force(
-      {Vec2{cxa[0], cya[0]}, Vec2{cxa[1], cya[1]}, Vec2{cxa[2], cya[2]}},
-      {Vec2{txa[0], tya[0]}, Vec2{txa[1], tya[1]}, Vec2{txa[2], tya[2]}}, penalty * thickness);
+  const PairForce f = triangle_pair_force(cv, tv, penalty * thickness);
   if (!(f.area > 0.0)) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;
     return false;

@@ -84,14 +84,18 @@ RunBookkeeping decode(const std::vector<double>& v, const std::string& path) {
   auto bad = [&] {
     return DeckError("restart file '" + path + "': not written by `voussoir run`");
   };
+  // Counts travel as doubles (exact below 2^53); anything else is not ours.
+  auto count = [&](double c) {
+    if (!(c >= 0.0 && c <= 9007199254740992.0) || c != std::floor(c)) throw bad();
+    return static_cast<std::int64_t>(c);
+  };
   if (v.size() < 6 || v[0] != kDriverFormat) throw bad();
   RunBookkeeping b;
   b.next_snapshot = v[1];
   b.max_energy_error = v[2];
-  b.stats.max_active_pairs = static_cast<std::int64_t>(v[3]);
+  b.stats.max_active_pairs = count(v[3]);
   b.stats.wall_s = v[4];
-  const double rows = v[5];
-  if (!(rows >= 0.0) || rows * kRowValues != static_cast<double>(v.size() - 6)) throw bad();
+  if (static_cast<std::size_t>(count(v[5])) * kRowValues != v.size() - 6) throw bad();
   for (std::size_t k = 6; k < v.size(); k += kRowValues) {
     SeriesRecord r;
     r.time = v[k];
@@ -102,7 +106,7 @@ RunBookkeeping decode(const std::vector<double>& v, const std::string& path) {
     r.friction_dissipated = v[k + 5];
     r.external_work = v[k + 6];
     r.max_displacement = v[k + 7];
-    r.active_contacts = static_cast<std::int64_t>(v[k + 8]);
+    r.active_contacts = count(v[k + 8]);
     r.energy_balance_error = v[k + 9];
     b.rows.push_back(r);
   }
@@ -187,6 +191,7 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
   loop.label = "run";
   if (checkpoints) {
     loop.checkpoint_every = opts.checkpoint_every;
+    loop.checkpoint_at_end = true;  // so that a restart can extend a finished run
     loop.checkpoint = [&](const Simulation& s, const LoopStats& st) {
       book.stats = st;
       write_checkpoint(ckpt_path, s, fingerprint, friction, encode(book));
@@ -200,10 +205,6 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
   } catch (const std::exception& e) {
     if (write) writer.close_incomplete(e.what());
     throw;
-  }
-  if (checkpoints) {  // the end state too, so that a restart can extend the run
-    book.stats = stats;
-    write_checkpoint(ckpt_path, sim, fingerprint, friction, encode(book));
   }
   const double max_energy_error = book.max_energy_error;
   const double dmax = max_free_displacement(sim.model);

@@ -113,11 +113,21 @@ LoopStats run_loop(Simulation& sim, const LoopOptions& opts,
   const long long ckpt_every =
       (opts.checkpoint && opts.checkpoint_every > 0.0) ? steps_of(opts.checkpoint_every) : 0;
   bool go_on = sim.step == 0 ? sample(sim) : true;
+  auto write_checkpoint = [&] {
+    check_finite(sim);  // never checkpoint a broken state
+    stats.steps = sim.step;
+    stats.wall_s = resume.wall_s + std::chrono::duration<double>(clock::now() - start).count();
+    opts.checkpoint(sim, stats);
+  };
   while (sim.step < total_steps && go_on) {
     advance(sim);
     stats.max_active_pairs = std::max(stats.max_active_pairs, sim.contact.active_pairs());
     const bool last = sim.step == total_steps;
-    if (sim.step % every == 0 || last) {
+    const bool on_grid = sim.step % every == 0;
+    const bool checkpoint_due = ckpt_every > 0 && ((sim.step % ckpt_every == 0 && !last) ||
+                                                   (last && opts.checkpoint_at_end));
+    if (checkpoint_due && !on_grid) write_checkpoint();
+    if (on_grid || last) {
       check_finite(sim);
       if (opts.drift_limit > 0.0 && sim.step >= opts.drift_arm_steps)
         check_energy_balance(sim, opts.drift_limit);
@@ -129,12 +139,7 @@ LoopStats run_loop(Simulation& sim, const LoopOptions& opts,
                      sim.ctx.time, opts.end_time, sim.step, sim.ledger.kinetic);
       }
     }
-    if (ckpt_every > 0 && sim.step % ckpt_every == 0 && !last && go_on) {
-      check_finite(sim);  // never checkpoint a broken state
-      stats.steps = sim.step;
-      stats.wall_s = resume.wall_s + std::chrono::duration<double>(clock::now() - start).count();
-      opts.checkpoint(sim, stats);
-    }
+    if (checkpoint_due && on_grid && go_on) write_checkpoint();
   }
   stats.steps = sim.step;
   stats.wall_s = resume.wall_s + std::chrono::duration<double>(clock::now() - start).count();

@@ -6,14 +6,24 @@
 // Guards (SPEC.md section 2: "no NaN silently written"; docs/robustness.md). At every sample:
 //   - non-finite: any node position, velocity or force, or any term of the energy ledger,
 //     that is NaN or infinite stops the run (check_finite);
-//   - energy drift: the ledger's balance error |W - K - U - C - D| / (peak energy) above
-//     kEnergyDriftLimit stops the run (check_energy_balance). The central-difference ledger
-//     of core/step.cpp is exact for linear systems and O(dt^2) otherwise: the stiff and
-//     extreme cases of tests/unit/test_stability.cpp stay below 1e-3 (docs/robustness.md), so
-//     5% is a factor of 50 above anything a sound run produces, while an unstable step makes
-//     the error grow geometrically and crosses it within a few tens of steps, long before a
-//     NaN. The error is relative to the largest energy term seen so far, so the threshold
-//     does not depend on the deck's units, size or load.
+//   - energy drift: the ledger's balance error |W - K - U - C - D| / (peak energy so far)
+//     above kEnergyDriftLimit = 5% stops the run (check_energy_balance), once the run is
+//     kEnergyDriftArmSteps = 1000 steps old. The central-difference ledger of core/step.cpp is
+//     exact for linear systems and O(dt^2) otherwise: over whole runs the stiff and extreme
+//     cases of tests/unit/test_stability.cpp stay below 1e-2 of their peak energy, 5% being
+//     well above that, except where the resolution of the contact energy at 1e-12 m deep
+//     overlaps (~1e-5 J, a narrow-phase defect reported in docs/robustness.md) is not small
+//     against a tiny peak energy: the arch with density 1 (peak 1e-5 J) trips this guard. The error
+//     is relative to the largest energy term seen so far, so the threshold depends on no unit, size
+//     or load of the deck. Why armed late: the peak energy of a run from rest starts at zero, and
+//     during the first steps the first contact and friction increments are a sizeable share of it
+//     (measured: 1.7% at step 100 of the collapsing thin arch, 1.3% at step 50 of the block on a 60
+//     degree incline, 21% at step 50 of the E = 200 GPa arch, the last from the contact energy
+//     resolution above); by step 1000 the energies have grown past it. What it catches: a time step
+//     above the stable limit (twice the limit on the block deck: error 0.92 at step 1000, while the
+//     state stays finite -- the viscous term oscillates and books dissipation without bound, and
+//     the hyperelastic law keeps even an undamped blow-up finite), work booked twice or lost, a
+//     contact energy out of step with its forces.
 // Both throw RunError (exit status 1) naming the step, the time and where: the node, its
 // block and a triangle that holds it.
 
@@ -57,8 +67,11 @@ struct LoopOptions {
   long long drift_arm_steps = kEnergyDriftArmSteps;  // guard checked from this step on
   // Checkpoints: `checkpoint(sim, stats)` after every `checkpoint_every` seconds of simulated
   // time (rounded to whole steps, at least one; 0 = never), after that step's sample if it has
-  // one, never after the last step.
+  // one; and, with checkpoint_at_end, after the last step too -- but before its sample when
+  // that step is off the sample grid (the end-of-run sample that a longer run would not take),
+  // so that a run restarted from it and extended samples exactly as the longer run does.
   double checkpoint_every = 0.0;
+  bool checkpoint_at_end = false;
   std::function<void(const Simulation&, const LoopStats&)> checkpoint;
 };
 

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 #include "io/deck.hpp"
@@ -29,9 +30,10 @@ constexpr std::uint32_t kByteOrderTag = 0x01020304u;
 // The contact state interface requested from contact/ (io/checkpoint.hpp "Contact state"),
 // detected at compile time so that this file builds with and without it.
 template <class C>
-concept HasContactState = requires(const C& c, C& m, const std::vector<char>& bytes) {
+concept HasContactState = requires(const C& c, C& m, const Model& model,
+                                   const std::vector<char>& bytes) {
   { c.save_state() } -> std::convertible_to<std::vector<char>>;
-  m.restore_state(bytes);
+  m.restore_state(model, bytes);
 };
 
 template <class C>
@@ -44,13 +46,20 @@ std::vector<char> save_contact(const C& contact) {
 }
 
 template <class C>
-void restore_contact(C& contact, const std::vector<char>& bytes) {
+void restore_contact(C& contact, const Model& model, const std::vector<char>& bytes,
+                     const std::string& path) {
   if constexpr (HasContactState<C>) {
-    contact.restore_state(bytes);
+    try {
+      contact.restore_state(model, bytes);
+    } catch (const std::exception& e) {
+      throw DeckError("restart file '" + path + "': " + e.what());
+    }
   } else {
     // A fresh set-up re-detects at the first step: exact without friction (header).
     (void)contact;
+    (void)model;
     (void)bytes;
+    (void)path;
   }
 }
 
@@ -287,7 +296,7 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   n.vx = std::move(vx);
   n.vy = std::move(vy);
   sim.viscous_piola = std::move(piola);
-  restore_contact(sim.contact, contact);
+  restore_contact(sim.contact, sim.model, contact, path);
   return driver;
 }
 

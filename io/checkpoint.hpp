@@ -24,8 +24,8 @@
 // and the broad phase's positions of the last detection behind a private Impl
 // (contact/contact.cpp), so this file can only save what its public interface gives:
 //   - if ContactSystem has `std::vector<char> save_state() const` and
-//     `void restore_state(const std::vector<char>&)` (requested from the contact stage for
-//     this issue), the opaque bytes are saved and restored: exact in every case;
+//     `void restore_state(const Model&, const std::vector<char>&)` (requested from the contact
+//     stage for this issue), the opaque bytes are saved and restored: exact in every case;
 //   - otherwise the contact system restarts from a fresh set-up and re-detects at the first
 //     step. That is exact when friction is off: the narrow phase adds the forces and energies
 //     of the overlapping pairs in sorted pair order, every valid candidate list contains every

@@ -62,3 +62,83 @@ TEST(Fuzz, GmshFile) {
 
 }  // namespace
 }  // namespace voussoir::testing
+
+// Inputs the fuzzer found that broke the exit-status contract when it was written (issue 8),
+// each reduced to --set overrides of a shipped deck (or a two-line polygon change), kept here so
+// that a fix is seen at once and never undone. Each must exit 0 or 2 from `check`; the last
+// one must finish a 1e-4 s `run` within the fuzz time limit (or be refused).
+namespace voussoir::testing {
+namespace {
+
+ProcessResult check_with(const std::string& deck, const std::vector<std::string>& sets,
+                         const std::string& command = "check") {
+  std::vector<std::string> args = {VOUSSOIR_BINARY, command, source_path("cases/" + deck), "-q"};
+  for (const std::string& s : sets) args.insert(args.end(), {"--set", s});
+  Limits limits;
+  limits.wall_s = command == "run" ? 40 : 20;
+  limits.cpu_s = 2 * limits.wall_s;
+  const std::string scratch = (fuzz_fs::temp_directory_path() / "voussoir_finding").string();
+  return run_process(args, limits, scratch);
+}
+
+void expect_refused_or_accepted(const ProcessResult& r) {
+  EXPECT_TRUE(r.exited && (r.status == 0 || r.status == 2))
+      << r.describe() << "\nstderr: " << r.err;
+  if (r.exited && r.status == 2) EXPECT_NE(r.err.find("voussoir: error:"), std::string::npos);
+}
+
+// mesh/scenes_arch.cpp: an embrace of 1 degree, 11 voussoirs -> "triangulate_polygon: the
+// outline is not a simple polygon" as a run failure (exit 1).
+TEST(FuzzFindings, ArchEmbraceOneDegree) {
+  expect_refused_or_accepted(check_with("circular_arch.toml", {"model.embrace=1"}));
+}
+
+// mesh/scenes_arch.cpp: radius 4e10 m -> "cannot create std::vector larger than max_size()"
+// (exit 1): the triangle-count limit does not see the radius.
+TEST(FuzzFindings, ArchHugeRadius) {
+  expect_refused_or_accepted(check_with("gilbert_arch.toml", {"model.radius=40e9"}));
+}
+
+// mesh/scenes_arch.cpp: embrace 5e-324 degrees -> vector larger than max_size() (exit 1).
+TEST(FuzzFindings, ArchDenormalEmbrace) {
+  expect_refused_or_accepted(check_with("scaled_arch.toml", {"model.embrace=5e-324"}));
+}
+
+// mesh/scenes_block.cpp: a 4e10 m tall block -> vector larger than max_size() (exit 1).
+TEST(FuzzFindings, BlockHugeHeight) {
+  expect_refused_or_accepted(check_with("block.toml", {"model.height=40e9"}));
+}
+
+// mesh/scenes_church.cpp: outer_width 4294967296 m -> std::bad_alloc (exit 1).
+TEST(FuzzFindings, ChurchHugeOuterWidth) {
+  expect_refused_or_accepted(check_with("church_a.toml", {"model.outer_width=4294967296"}));
+}
+
+// mesh/scenes_polygons.cpp: a polygon vertex at y = 2147483648 m -> std::bad_alloc (exit 1).
+TEST(FuzzFindings, PolygonHugeCoordinate) {
+  const fuzz_fs::path dir = fuzz_fs::temp_directory_path() / "voussoir_finding_polygon";
+  fuzz_fs::create_directories(dir);
+  write_text((dir / "blocks.txt").string(),
+             "block\n-0.25 0\n0.25 0\n0.25 2147483648\n-0.25 1\n\nblock\n-1.75 -0.25\n"
+             "1.75 -0.25\n1.75 0\n-1.75 0\n");
+  write_text((dir / "deck.toml").string(),
+             "[model]\nkind = \"polygons\"\nfile = \"blocks.txt\"\nfixed = [1]\n");
+  Limits limits;
+  limits.wall_s = 20;
+  limits.cpu_s = 40;
+  expect_refused_or_accepted(
+      run_process({VOUSSOIR_BINARY, "check", (dir / "deck.toml").string(), "-q"}, limits,
+                  (dir / "child").string()));
+  fuzz_fs::remove_all(dir);
+}
+
+// mesh/scenes_arch.cpp (or io/deck.cpp ranges): embrace 0.092 degrees with 13 voussoirs of a
+// 36 mm thick arch makes 46 micrometre wide voussoirs, 39734 triangles and dt = 7.5e-11 s:
+// `check` accepts it, and `run` to 1e-4 s (1.3 million steps) does not end in 40 s.
+TEST(FuzzFindings, ArchSliverVoussoirsRun) {
+  expect_refused_or_accepted(
+      check_with("scaled_arch.toml", {"model.embrace=0.092", "solver.end_time=1e-4"}, "run"));
+}
+
+}  // namespace
+}  // namespace voussoir::testing
