@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 
@@ -182,8 +183,26 @@ Model mesh_scene(Scene& scene, const Config& config) {
 }
 
 Model build_model(const Config& config) {
-  Scene scene = build_scene(config);
-  return mesh_scene(scene, config);
+  // The checks of build_scene and the triangle budget catch the usual bad values; what still
+  // fails inside the meshers (outlines that degenerate at extreme values, sizes whose boundary
+  // subdivision overflows memory, found by tests/unit/test_fuzz.cpp) is a bad deck too, and
+  // is reported as one (exit status 2), naming what went wrong.
+  const std::string where = config.deck_path.empty() ? std::string() : config.deck_path + ": ";
+  try {
+    Scene scene = build_scene(config);
+    return mesh_scene(scene, config);
+  } catch (const DeckError&) {
+    throw;
+  } catch (const std::length_error&) {
+    throw DeckError(where + "the mesh of this model does not fit in memory: check the [model] "
+                            "dimensions against mesh.size / mesh.through_thickness");
+  } catch (const std::bad_alloc&) {
+    throw DeckError(where + "the mesh of this model does not fit in memory: check the [model] "
+                            "dimensions against mesh.size / mesh.through_thickness");
+  } catch (const std::exception& e) {
+    throw DeckError(where + "the model cannot be meshed (" + e.what() +
+                    "): check the [model] values (angles, dimensions) for degenerate blocks");
+  }
 }
 
 Vec2 centreline_point(const Scene& scene, double s) {

@@ -190,6 +190,18 @@ void add_voussoirs(const Config& config, const HalfCentreline& cl, Scene& scene,
   const int nv = mc.voussoirs;
   if (nv < 1) geometry_error(config, "model.voussoirs", nv, "an arch needs at least 1 voussoir");
   const double t = mc.thickness, beta_deg = mc.embrace;
+  // A voussoir much thinner along the arch than across it is a slice, not a block: its
+  // meshing needs slivers or tens of thousands of cells and a time step of ~1e-10 s (found by
+  // tests/unit/test_fuzz.cpp: embrace 0.092 deg with 13 voussoirs). Refuse beyond 1:50.
+  constexpr double kMaxSlenderness = 50.0;
+  const double voussoir_length = 2.0 * cl.half_length / nv;
+  if (t > kMaxSlenderness * voussoir_length) {
+    std::ostringstream why;
+    why << "gives voussoirs " << voussoir_length << " m long for a thickness of " << t
+        << " m (more than " << kMaxSlenderness << " times thinner than thick): use fewer "
+        << "voussoirs or a larger embrace or radius";
+    geometry_error(config, "model.embrace", beta_deg, why.str());
+  }
   const double h = element_size(config, t);
   int n = 1, m = 1;
   choose_band_cells(t, 2.0 * cl.half_length / nv, 0.5 * t / cl.min_radius, h, &n, &m);
