@@ -177,6 +177,7 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
 
   record(sim);
   std::vector<double> measure;  // motion measure after the signal (timeout decision)
+  double max_imbalance = 0.0;   // largest |W - K - U - C - D| at the samples [J]
   double rest_since = -1.0;
   bool decided = false;
   const double body_x0 = lambda * g;
@@ -191,7 +192,9 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
     if (k % every != 0) continue;
     check_finite(sim);
     const double ts = sim.ctx.time - t0;
-    r.max_energy_balance_error = std::max(r.max_energy_balance_error, sim.ledger.balance_error());
+    const EnergyLedger& l = sim.ledger;
+    max_imbalance =
+        std::max(max_imbalance, std::abs(l.external_work - l.stored() - l.dissipated()));
     update_controls(sim);
     const std::vector<BlockMotion> now = block_motions(sim.model);
     double dmax = 0.0, rmax = 0.0;
@@ -231,9 +234,15 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   }
   record(sim);
   r.steps = sim.step - step0;
-  r.energy_balance_error = sim.ledger.balance_error();
-  r.max_energy_balance_error = std::max(r.max_energy_balance_error, r.energy_balance_error);
-  r.peak_energy = sim.ledger.max_energy;
+  // Largest imbalance over the run relative to the run's peak energy (SPEC: "below 1% of the
+  // peak energy"). Not the largest of balance_error() over time: early in a run that divides
+  // by the small energies of the settled state, and round-off-sized imbalances then read as
+  // tens of percent.
+  const EnergyLedger& l = sim.ledger;
+  max_imbalance = std::max(max_imbalance, std::abs(l.external_work - l.stored() - l.dissipated()));
+  r.energy_balance_error = l.balance_error();
+  r.peak_energy = l.max_energy;
+  r.max_energy_balance_error = l.max_energy > 0.0 ? max_imbalance / l.max_energy : 0.0;
   const double tol = kHingeFraction * settled.l_ref;
   r.hinges = find_hinges(sim.model, tol, tol);
   r.wall_s = seconds_since(wall0);

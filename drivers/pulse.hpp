@@ -105,14 +105,15 @@ struct PulseResult {
   double decided_at = 0.0;  // signal time of the decision [s]
   long long steps = 0;
   double wall_s = 0.0;
-  double max_kinetic_energy = 0.0;        // [J]
-  double energy_balance_error = 0.0;      // at the end
-  double max_energy_balance_error = 0.0;  // largest over the samples
-  double peak_energy = 0.0;               // ledger max energy [J]
-  double max_displacement = 0.0;          // largest block centroid displacement seen [m]
-  double max_rotation = 0.0;              // [rad]
-  double residual_displacement = 0.0;     // at the end [m]
-  double residual_rotation = 0.0;         // [rad]
+  double max_kinetic_energy = 0.0;    // [J]
+  double energy_balance_error = 0.0;  // at the end (EnergyLedger::balance_error)
+  // Largest |W - K - U - C - D| over the samples / the run's peak energy.
+  double max_energy_balance_error = 0.0;
+  double peak_energy = 0.0;            // ledger max energy [J]
+  double max_displacement = 0.0;       // largest block centroid displacement seen [m]
+  double max_rotation = 0.0;           // [rad]
+  double residual_displacement = 0.0;  // at the end [m]
+  double residual_rotation = 0.0;      // [rad]
   std::vector<ControlSummary> control;
   std::vector<Hinge> hinges;  // joints open or slid at the end
 };

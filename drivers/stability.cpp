@@ -87,6 +87,41 @@ double reference_length(const Model& model) {
   return std::isfinite(a) ? std::sqrt(a) : 1.0;
 }
 
+// At rest (capacity's rule, drivers/capacity.cpp): the largest free-node speed has stayed
+// below v_rest for the hold window and the kinetic energy is not growing over it (its peak
+// over the second half of the window is no larger than over the first half), which tells a
+// decaying oscillation from a mechanism that has just started and is still slow.
+class RestDetector {
+ public:
+  RestDetector(double v_rest, double hold) : v_rest_(v_rest), hold_(hold) {}
+  bool update(double t, double v_max, double kinetic) {
+    if (v_max >= v_rest_) {
+      window_.clear();
+      return false;
+    }
+    window_.push_back({t, kinetic});
+    const double t0 = window_.front().t;
+    if (t - t0 < hold_) return false;
+    const double mid = t0 + 0.5 * (t - t0);
+    double first = 0.0, second = 0.0;
+    for (const Sample& s : window_) {
+      double& peak = s.t <= mid ? first : second;
+      peak = std::max(peak, s.kinetic);
+    }
+    if (second <= first) return true;
+    // Growing: keep watching the second half.
+    while (!window_.empty() && window_.front().t <= mid) window_.erase(window_.begin());
+    return false;
+  }
+
+ private:
+  struct Sample {
+    double t, kinetic;
+  };
+  double v_rest_, hold_;
+  std::vector<Sample> window_;
+};
+
 bool is_arch(const std::string& kind) {
   return kind == "circular_arch" || kind == "basket_arch" || kind == "buttressed_arch";
 }
@@ -186,7 +221,7 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   const std::vector<BlockMotion> base = block_motions(sim.model);  // rest, unloaded
 
   std::vector<double> measure;  // motion measure per sample (1 = collapse threshold)
-  double rest_since = -1.0;
+  RestDetector rest(v_rest, tc.hold_time);
   bool decided = false, ke_read = false;
   while (!(decided && ke_read)) {
     const double t = sim.ctx.time;
@@ -216,15 +251,10 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
       c.reason = dmax > d_collapse ? "displacement" : "rotation";
       decided = true;
     } else if (now >= tc.ramp_time) {
-      if (max_free_speed(sim.model.nodes) < v_rest) {
-        if (rest_since < 0.0) rest_since = now;
-        if (now - rest_since >= tc.hold_time) {
-          c.stable = true;
-          c.reason = "rest";
-          decided = true;
-        }
-      } else {
-        rest_since = -1.0;
+      if (rest.update(now, max_free_speed(sim.model.nodes), sim.ledger.kinetic)) {
+        c.stable = true;
+        c.reason = "rest";
+        decided = true;
       }
       if (!decided && now >= tc.max_time) {
         // Critical slowing down near the threshold: decide by the trend, as capacity does
@@ -237,16 +267,7 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
         decided = true;
       }
     }
-    if (decided) {
-      c.decision_time = now;
-      // At rest before ke_time: stop and report the energy at the decision (an upper bound
-      // of the value at ke_time).
-      if (c.stable && !ke_read) {
-        c.kinetic_energy = sim.ledger.kinetic;
-        c.ke_read_time = now;
-        ke_read = true;
-      }
-    }
+    if (decided) c.decision_time = now;
   }
   c.normalised_ke = ke_scale > 0.0 ? c.kinetic_energy / ke_scale : 0.0;
   c.sim_time = sim.ctx.time;

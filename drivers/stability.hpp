@@ -12,7 +12,8 @@
 //          collapse_displacement x L_ref (0.05 L_ref) or rotated more than collapse_rotation
 //          (0.05 rad), L_ref = square root of the smallest free block area;
 //        stable as soon as, after the ramp, the largest free-node speed has stayed below
-//          rest_speed x sqrt(g L_ref) (1e-4) for hold_time (0.05 s);
+//          rest_speed x sqrt(g L_ref) for hold_time and the kinetic energy has not grown over
+//          that window (capacity's rest rule: peak of its second half <= peak of its first);
 //        otherwise at `max_time` (3 s of simulated time from the start): collapsed if the motion
 //          measure max(d / d_collapse, |rotation| / rot_collapse) at the end exceeds by 10% its
 //          largest value over the first two thirds of the run, stable otherwise ("timeout").
@@ -20,10 +21,9 @@
 //      start of the gravity ramp), M the free mass and L the reference length of the scene
 //      (`ke_length`: the centreline radius Rc for arches, the height of the free blocks'
 //      bounding box for other scenes). It is the fraction of the potential energy of a drop
-//      of L that has turned into motion. Collapsed cells are run on to `ke_time` when they
-//      cross the collapse threshold earlier; a cell found at rest before `ke_time` is stopped
-//      there and reports the kinetic energy at the rest decision (a structure at rest under
-//      a constant load stays at rest, so this bounds the value at ke_time from above).
+//      of L that has turned into motion. Every cell runs at least to `ke_time`, whenever it
+//      was classified (a collapsed cell runs on after crossing the threshold, a cell found at
+//      rest is followed to ke_time), so the energies of all cells are read at the same time.
 //   4. cross-check: rigid-block limit analysis (limit/limit_analysis.hpp, gravity only) on the
 //      same blocks says whether an admissible equilibrium exists; `disagree` flags cells where
 //      the FDEM classification differs from it. Limit analysis assumes associative friction and

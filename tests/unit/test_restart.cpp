@@ -2,7 +2,7 @@
 // restarted from a checkpoint ends bit for bit where the uninterrupted run ends -- every node
 // position and velocity, every ledger term, the step and the time -- and writes the same series
 // and summary. Scene: the shipped circular arch on a coarse mesh under lambda = 0.5 (above its
-// lambda* of 0.29), so blocks move and contacts open and close, with a 0.2 mm contact buffer so
+// lambda* of 0.29), so blocks move and contacts open and close, with a 0.1 mm contact buffer so
 // that the broad phase re-detects several times after the restart point.
 //
 // Contact friction history: restored only when ContactSystem offers save_state/restore_state
@@ -38,7 +38,7 @@ constexpr double kEndTime = 0.012;  // [s], about 17000 steps
 
 Config arch(double friction, double end_time) {
   return load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml",
-                   {"mesh.through_thickness=1", "load.lambda=0.5", "contact.buffer=0.0002",
+                   {"mesh.through_thickness=1", "load.lambda=0.5", "contact.buffer=0.0001",
                     "contact.friction=" + std::to_string(friction),
                     "solver.end_time=" + std::to_string(end_time), "output.every=0.002"});
 }

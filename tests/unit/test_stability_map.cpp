@@ -23,7 +23,8 @@ const std::vector<std::string> kCoarse = {"mesh.through_thickness=1", "material.
 
 StabilityCriteria fast_criteria() {
   StabilityCriteria c;
-  c.ke_time = 0.2;         // [s] the thin arch crosses the threshold at ~0.1 s
+  c.ke_time = 0.3;         // [s] the thin arch crosses the threshold at ~0.1 s; the thick one has
+                           // stopped ringing after the ramp (KE/MgRc ~1e-7; 8e-7 at 0.2 s)
   c.trial.max_time = 1.5;  // [s] the thick arch is at rest by ~0.7 s
   return c;
 }

@@ -5,7 +5,8 @@
 // block cannot start rocking unless the pulse peak (0.891 A for 3 cycles) exceeds
 // g width/height, so A_c >= 0.5 / 0.891 = 0.561 g, and a faster pulse needs more amplitude
 // (Housner: the overturning amplitude grows with frequency above the static threshold).
-// About a minute on one core (E lowered to 1 GPa, mesh of one element across).
+// Measured: A_c = 2.19 g at 2 Hz, 4.69 g at 4 Hz (bisection brackets within 2%).
+// About 4 s of CPU (E lowered to 1 GPa, mesh of one element across).
 
 #include <gtest/gtest.h>
 
