@@ -77,7 +77,11 @@ ProcessResult check_with(const std::string& deck, const std::vector<std::string>
   Limits limits;
   limits.wall_s = command == "run" ? 40 : 20;
   limits.cpu_s = 2 * limits.wall_s;
-  const std::string scratch = (fuzz_fs::temp_directory_path() / "voussoir_finding").string();
+  // One scratch folder per process: ctest runs these tests side by side.
+  const std::string scratch =
+      (fuzz_fs::temp_directory_path() /
+       ("voussoir_finding_" + std::to_string(static_cast<long long>(::getpid()))))
+          .string();
   return run_process(args, limits, scratch);
 }
 
