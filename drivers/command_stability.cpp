@@ -201,6 +201,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
     std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
                       "/scripts/plot_stability '" + csv_path + "' -o '" + opts.plot + "'";
     if (keep_modes) cmd += " --modes '" + opts.mode_out + "'";
+    std::fflush(stdout);  // our summary before the script's table
     if (std::system(cmd.c_str()) != 0)
       std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
                    opts.plot.c_str());

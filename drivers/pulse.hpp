@@ -107,8 +107,11 @@ struct PulseResult {
   double wall_s = 0.0;
   double max_kinetic_energy = 0.0;    // [J]
   double energy_balance_error = 0.0;  // at the end (EnergyLedger::balance_error)
-  // Largest |W - K - U - C - D| over the samples / the run's peak energy.
+  // Largest |W - K - U - C - D| over the samples / the run's peak energy (settling included).
   double max_energy_balance_error = 0.0;
+  // Largest change of W - K - U - C - D since the signal start / the run's peak energy: the
+  // balance of the base-motion phase alone.
+  double pulse_energy_balance_error = 0.0;
   double peak_energy = 0.0;            // ledger max energy [J]
   double max_displacement = 0.0;       // largest block centroid displacement seen [m]
   double max_rotation = 0.0;           // [rad]

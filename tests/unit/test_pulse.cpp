@@ -65,6 +65,7 @@ TEST(PulseBlock, BaseStepBelowThresholdDoesNotRockAboveOverturns) {
   EXPECT_LT(below.max_rotation, 1e-3);
   EXPECT_GE(below.decided_at, 1.5);  // classified only after the step ended
   EXPECT_LT(below.max_energy_balance_error, 0.01);
+  EXPECT_LT(below.pulse_energy_balance_error, 0.01);
 
   const PulseResult above = run_step(0.55, 3.0);
   EXPECT_TRUE(above.collapsed);
@@ -74,6 +75,7 @@ TEST(PulseBlock, BaseStepBelowThresholdDoesNotRockAboveOverturns) {
   ASSERT_EQ(above.control.size(), 1u);
   EXPECT_LT(above.control[0].final_ux, -0.2);  // the top went to -x
   EXPECT_LT(above.max_energy_balance_error, 0.01);
+  EXPECT_LT(above.pulse_energy_balance_error, 0.01);
 }
 
 // Control points of the shaking-table arch: the extrados corners of the sixth voussoir from
