@@ -157,20 +157,71 @@ inline void integrate_phi(const double* alpha, const double* beta, double& i0, d
   i1 = 0.5 * j1;
 }
 
-// Field of triangle T (barycentric lam, centroid (gx, gy)) over P, by boundary integrals.
+// int_Q f dA for f affine over a convex polygon Q (counter-clockwise): a fan of triangles from
+// Q's first vertex, each its area times the mean of f at its corners, f clamped at zero at
+// the vertices (it is a barycentric coordinate of a triangle containing Q; a clipped vertex
+// may lie a rounding error outside). Coordinates relative to the first vertex, so a thin Q
+// keeps its area to the rounding of its vertices.
+inline double integrate_affine(const Poly& Q, const Affine& f) {
+  if (Q.n < 3) return 0.0;
+  const double x0 = Q.x[0], y0 = Q.y[0];
+  const double f0 = std::max(0.0, f(x0, y0));
+  double f_prev = std::max(0.0, f(Q.x[1], Q.y[1]));
+  double sum = 0.0;  // sum of (twice the area) x (sum of the three corner values)
+  for (int k = 2; k < Q.n; ++k) {
+    const double fk = std::max(0.0, f(Q.x[k], Q.y[k]));
+    const double cr = (Q.x[k - 1] - x0) * (Q.y[k] - y0) - (Q.y[k - 1] - y0) * (Q.x[k] - x0);
+    sum += cr * (f0 + f_prev + fk);
+    f_prev = fk;
+  }
+  return sum * (1.0 / 6.0);
+}
+
+// Phi_T = int_P phi_T dA, piece by piece: on P n R_m(T) phi_T = 3 lambda_m is affine, so its
+// integral is exact from the piece's vertex values, and lambda_m is evaluated directly
+// (a scaled distance to edge m: small where the overlap is thin, never "1 - something").
+// The relative error is that of the clipped vertices' distances to the edges, ~eps L / d for
+// a strip of depth d and length L (tests/unit/test_narrow_phase.cpp, ThinStripEnergy*).
+// Usually P lies in one sub-triangle (all its vertices have the same smallest coordinate; P
+// and R_m are convex, so then P is inside R_m) and one fan does it; otherwise P is clipped
+// to each R_m = {lambda_i >= lambda_m, lambda_j >= lambda_m}.
+// Rejected: Phi = (oint phi (x - G) . n ds + A_P) / 3 (one boundary pass with the other
+// integrals) subtracts two quantities of the size of A_P; at rest (d ~ 1e-11 L) it lost every
+// digit and even turned negative (docs/robustness.md section 2).
+inline double potential_integral(const Bary& T, const Poly& P) {
+  auto argmin = [&](int v) {
+    const double l0 = T.lam[0](P.x[v], P.y[v]), l1 = T.lam[1](P.x[v], P.y[v]),
+                 l2 = T.lam[2](P.x[v], P.y[v]);
+    return l0 <= l1 ? (l0 <= l2 ? 0 : 2) : (l1 <= l2 ? 1 : 2);
+  };
+  const int m0 = argmin(0);
+  bool one_piece = true;
+  for (int v = 1; v < P.n && one_piece; ++v) one_piece = argmin(v) == m0;
+  if (one_piece) return 3.0 * integrate_affine(P, T.lam[m0]);
+  double phi = 0.0;
+  Poly half, piece;
+  for (int m = 0; m < 3; ++m) {
+    const Affine& lm = T.lam[m];
+    const Affine& li = T.lam[(m + 1) % 3];
+    const Affine& lj = T.lam[(m + 2) % 3];
+    clip(P, {li.a - lm.a, li.b - lm.b, li.c - lm.c}, half);
+    if (half.n < 3) continue;
+    clip(half, {lj.a - lm.a, lj.b - lm.b, lj.c - lm.c}, piece);
+    phi += 3.0 * integrate_affine(piece, lm);
+  }
+  return phi;
+}
+
+// Field of triangle T (barycentric lam) over P, by boundary integrals, given Phi_T.
 // phi_T vanishes on T's edges, so only the edges of P lying on the other triangle count
 // (on_c == other_is_c). With n ds = (dy, -dx) ds_param on a counter-clockwise polygon:
 //     int_P grad phi dA     = sum (dy, -dx) I0,
 //     int_P x grad phi dA   = sum (dy, -dx) Ix - (Phi, 0),   (integration by parts)
-//     int_P y grad phi dA   = sum (dy, -dx) Iy - (0, Phi),
-//     Phi = int_P phi dA    = (sum (dy, -dx) . (Ix - gx I0, Iy - gy I0) + A_P) / 3,
-// the last because div(phi (x - G)) = grad phi . (x - G) + 2 phi = 3 phi - 1 on every
-// sub-triangle (phi = 3 lambda_m is affine there and equals 1 at G), and phi (x - G) is
-// continuous across the sub-triangle lines.
-inline Field field_over(const Bary& T, double gx, double gy, const Poly& P, const Moments& mp,
-                        unsigned char other_is_c) {
+//     int_P y grad phi dA   = sum (dy, -dx) Iy - (0, Phi).
+inline Field field_over(const Bary& T, const Poly& P, unsigned char other_is_c) {
   Field f;
-  double j0x = 0.0, j0y = 0.0, jxx = 0.0, jxy = 0.0, jyx = 0.0, jyy = 0.0, k = 0.0;
+  f.phi = potential_integral(T, P);
+  double j0x = 0.0, j0y = 0.0, jxx = 0.0, jxy = 0.0, jyx = 0.0, jyy = 0.0;
   for (int q = 0, r = 1; q < P.n; ++q, r = (r + 1 == P.n ? 0 : r + 1)) {
     if (P.on_c[q] != other_is_c) continue;
     const double ax = P.x[q], ay = P.y[q], dx = P.x[r] - ax, dy = P.y[r] - ay;
@@ -189,9 +240,7 @@ inline Field field_over(const Bary& T, double gx, double gy, const Poly& P, cons
     jxy -= dx * ix;
     jyx += dy * iy;
     jyy -= dx * iy;
-    k += dy * (ix - gx * i0) - dx * (iy - gy * i0);
   }
-  f.phi = (k + mp.area) * (1.0 / 3.0);
   f.g[0][0] = j0x;
   f.g[1][0] = j0y;
   f.g[0][1] = jxx - f.phi;
@@ -239,10 +288,8 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   PairForce out;
   const Edges et = edge_functions(tx, ty);
   const Bary bc = barycentric(ec), bt = barycentric(et);
-  const Field fc =
-      field_over(bc, (cx[0] + cx[1] + cx[2]) / 3.0, (cy[0] + cy[1] + cy[2]) / 3.0, P, mp, 0);
-  const Field ft =
-      field_over(bt, (tx[0] + tx[1] + tx[2]) / 3.0, (ty[0] + ty[1] + ty[2]) / 3.0, P, mp, 1);
+  const Field fc = field_over(bc, P, 0);
+  const Field ft = field_over(bt, P, 1);
 
   // Nodal forces: f_i(c) = Ep [(G_c - G_t) l_i^c - Phi_t grad N_i^c], and symmetrically.
   double d[2][3];

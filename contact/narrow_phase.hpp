@@ -39,29 +39,32 @@
 //     int_P grad phi dA     = oint phi n ds,
 //     int_P x grad phi dA   = oint x phi n ds - (Phi, 0),     (integration by parts)
 //     int_P y grad phi dA   = oint y phi n ds - (0, Phi),
-//     Phi = int_P phi dA    = (oint phi (x - G) . n ds + A_P) / 3,
-// the last because div(phi (x - G)) = grad phi . (x - G) + 2 phi = 3 phi - 1 on every
-// sub-triangle (phi = 3 lambda_m is affine there and 1 at the centroid G), phi (x - G) being
-// continuous across the sub-triangle lines. phi_T vanishes on T's own edges, so for the field
-// of c only the edges of P lying on t count, and conversely: one or two segments for a
-// typical contact. Along a segment phi_T = 3 min_m lambda_m is the lower envelope of three
-// lines (concave, at most three pieces), integrated exactly piece by piece (trapezoid and
-// Simpson weights, no quadrature error). This is the edge-wise integration of Munjiza's book
-// carried to the nodal forces: the same boundary integrals give the resultant (his) and the
-// shape-function moments that make the forces the gradient of E (ours).
-// Coordinates are shifted to a local origin (c's first vertex) and P's area and moments are
-// summed as a fan from its own first vertex: overlaps at rest are ~1e-10 m deep and absolute
-// coordinates would cancel catastrophically.
+// with Phi = int_P phi dA itself summed over the pieces P n R_m(T) (at most three, usually
+// one), where phi = 3 lambda_m is affine: a fan of triangles per piece, each its area times
+// the mean of 3 lambda_m at its corners, lambda_m evaluated directly (a scaled distance to
+// edge m, small where the overlap is thin). phi_T vanishes on T's own edges, so in the
+// boundary integrals only the edges of P lying on t count for the field of c, and
+// conversely: one or two segments for a typical contact. Along a segment phi_T = 3 min_m lambda_m
+// is the lower envelope of three lines (concave, at most three pieces), integrated exactly piece by
+// piece (trapezoid and Simpson weights, no quadrature error). This is the edge-wise integration of
+// Munjiza's book carried to the nodal forces: the same boundary integrals give the resultant (his)
+// and the shape-function moments that make the forces the gradient of E (ours). Coordinates are
+// shifted to a local origin (c's first vertex) and P's area and moments are summed as a fan from
+// its own first vertex: overlaps at rest are ~1e-10 m deep and absolute coordinates would cancel
+// catastrophically.
 //
 // Point of action. The forces on c have resultant F and moment M = sum (x F_y - y F_x) about
 // the origin (the area-change term contributes neither); their line of action is
 // {x : x F_y - y F_x = M}. We report the point of that line nearest the overlap centroid C0:
 //     x_F = C0 + (M - C0 x F) / |F|^2 (F_y, -F_x)         (C0 if F = 0).
 //
-// Tried and replaced (same results to round-off, measured with callgrind on one strip-shaped
-// overlap): splitting P into the three sub-triangle regions by clipping (~3000 instructions
-// per pair) and a fan of signed triangles from G cut at the sub-triangle lines (~3150); the
-// edge-wise form takes ~2060.
+// Tried and replaced (same forces to round-off, measured with callgrind on one strip-shaped
+// overlap): splitting P into the three sub-triangle regions by clipping for every integral
+// (~3000 instructions per pair) and a fan of signed triangles from G cut at the sub-triangle
+// lines (~3150); the edge-wise form takes ~2060. Its Phi was once the boundary integral
+// (oint phi (x - G) . n ds + A_P) / 3 (div(phi (x - G)) = 3 phi - 1 on every sub-triangle),
+// which subtracts two quantities of the size of the overlap area: for a resting strip ~1e-12
+// m deep it lost every digit of the energy (negative values; docs/robustness.md section 2).
 //
 // Negligible overlaps. An overlap smaller than kMinOverlapFraction of the smaller triangle's
 // area counts as no contact (no force, no energy, friction history reset). Such overlaps are

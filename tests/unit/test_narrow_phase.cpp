@@ -3,9 +3,13 @@
 // consistency, and the stick/slip return mapping.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include "contact/friction.hpp"
 #include "contact/narrow_phase.hpp"
@@ -225,6 +229,170 @@ TEST(NarrowPhase, IdenticalTrianglesCancel) {
   EXPECT_NEAR(f.resultant.y, 0.0, 1e-3);
   // Energy 2 Ep int phi dA = 2 Ep A / 3 (phi is a pyramid of height 1 over the triangle).
   EXPECT_NEAR(f.energy, 2.0 * 1e9 * 1.5 / 3.0, 1e-3);
+}
+
+namespace {
+
+// Long-double reference of the energy Ep int_P (phi_c + phi_t) dA (x86-64: 64-bit mantissa,
+// 2048 times finer than double), written independently of the kernel: P = t clipped by c's
+// edges, then each piece P n R_m(T) (the sub-triangle of T where lambda_m is the smallest
+// coordinate, phi_T = 3 lambda_m) contributes 3 A lambda_m(centroid), exact for affine lambda.
+using LD = long double;
+struct PointLD {
+  LD x, y;
+};
+using PolyLD = std::vector<PointLD>;
+
+// Keeps {p : a + b x + c y >= 0} of a convex polygon.
+PolyLD clip_ld(const PolyLD& in, LD a, LD b, LD c) {
+  PolyLD out;
+  for (std::size_t q = 0; q < in.size(); ++q) {
+    const PointLD& P = in[(q + in.size() - 1) % in.size()];
+    const PointLD& Q = in[q];
+    const LD fp = a + b * P.x + c * P.y, fq = a + b * Q.x + c * Q.y;
+    if ((fp < 0) != (fq < 0) && fp != 0 && fq != 0) {
+      const LD s = fp / (fp - fq);
+      out.push_back({P.x + s * (Q.x - P.x), P.y + s * (Q.y - P.y)});
+    }
+    if (fq >= 0) out.push_back(Q);
+  }
+  return out;
+}
+
+// Barycentric coordinate m of triangle T as (a, b, c): lambda = a + b x + c y.
+std::array<LD, 3> lambda_ld(const std::array<PointLD, 3>& T, int m) {
+  const PointLD& i = T[(m + 1) % 3];
+  const PointLD& j = T[(m + 2) % 3];
+  const LD area2 = (T[1].x - T[0].x) * (T[2].y - T[0].y) - (T[1].y - T[0].y) * (T[2].x - T[0].x);
+  const LD ex = j.x - i.x, ey = j.y - i.y;
+  return {(ey * i.x - ex * i.y) / area2, -ey / area2, ex / area2};
+}
+
+LD potential_ld(const std::array<PointLD, 3>& T, const PolyLD& P) {
+  LD sum = 0;
+  for (int m = 0; m < 3; ++m) {
+    const auto lm = lambda_ld(T, m), li = lambda_ld(T, (m + 1) % 3), lj = lambda_ld(T, (m + 2) % 3);
+    PolyLD piece = clip_ld(P, li[0] - lm[0], li[1] - lm[1], li[2] - lm[2]);
+    piece = clip_ld(piece, lj[0] - lm[0], lj[1] - lm[1], lj[2] - lm[2]);
+    if (piece.size() < 3) continue;
+    LD a2 = 0, sx = 0, sy = 0;  // twice the area, 6 x first moments (about piece[0])
+    for (std::size_t k = 2; k < piece.size(); ++k) {
+      const LD ux = piece[k - 1].x - piece[0].x, uy = piece[k - 1].y - piece[0].y;
+      const LD vx = piece[k].x - piece[0].x, vy = piece[k].y - piece[0].y;
+      const LD cr = ux * vy - uy * vx;
+      a2 += cr;
+      sx += (ux + vx) * cr;
+      sy += (uy + vy) * cr;
+    }
+    if (!(a2 > 0)) continue;
+    const LD gx = piece[0].x + sx / (3 * a2), gy = piece[0].y + sy / (3 * a2);
+    sum += 3 * (a2 / 2) * (lm[0] + lm[1] * gx + lm[2] * gy);
+  }
+  return sum;
+}
+
+LD energy_ld(const Tri& c, const Tri& t, double Ep) {
+  // Local coordinates about c's first vertex, as exact as the inputs (Sterbenz does not hold
+  // in general, but long double keeps 11 more bits of every difference).
+  std::array<PointLD, 3> cl, tl;
+  for (int k = 0; k < 3; ++k) {
+    cl[k] = {LD(c[k].x) - LD(c[0].x), LD(c[k].y) - LD(c[0].y)};
+    tl[k] = {LD(t[k].x) - LD(c[0].x), LD(t[k].y) - LD(c[0].y)};
+  }
+  PolyLD P(tl.begin(), tl.end());
+  for (int m = 0; m < 3; ++m) {
+    const auto l = lambda_ld(cl, m);
+    P = clip_ld(P, l[0], l[1], l[2]);
+  }
+  if (P.size() < 3) return 0;
+  return Ep * (potential_ld(cl, P) + potential_ld(tl, P));
+}
+
+// Relative error of the energy allowed for a strip of depth d and length L: the clipped
+// vertices carry an error of a few eps L across the strip, i.e. a relative error ~eps L / d
+// of the distances phi is made of (the bound of the rounding, not a fitted figure); the
+// factor 8 covers the handful of roundings per vertex (measured: up to 0.3 eps L / d).
+// 1e-12 for the deep end.
+double strip_tolerance(double depth, double length) {
+  return 1e-12 + 8.0 * std::numeric_limits<double>::epsilon() * length / depth;
+}
+
+}  // namespace
+
+// The example of docs/robustness.md section 2: the arch with E = 200 GPa at step 2, a strip
+// ~2.9e-12 m deep under a 0.2 m face. The energy was -2.2e-6 J (the former Phi subtracted two
+// quantities of the size of the overlap area); the exact one is ~1.7e-10 J.
+TEST(NarrowPhase, ThinStripEnergyOfTheStiffArch) {
+  const Tri c = {Vec2{-1.1000000000000001, -2.911501233756747e-12},
+                 Vec2{-0.90000000000000002, -2.9004055445454038e-12},
+                 Vec2{-0.97974648680724874, 0.14086627841769794}};
+  const Tri t = {Vec2{-1.1000000000000001, 0.0}, Vec2{-1.1000000000000001, -0.20000000000000001},
+                 Vec2{-0.90000000000000002, 0.0}};
+  const double Ep = 5.556e12;
+  const PairForce f = triangle_pair_force(c, t, Ep);
+  const double ref = static_cast<double>(energy_ld(c, t, Ep));
+  EXPECT_GT(ref, 1.5e-10);
+  EXPECT_LT(ref, 2.0e-10);
+  EXPECT_GT(f.energy, 0.0);
+  EXPECT_NEAR(f.energy, ref, strip_tolerance(2.9e-12, 0.2) * ref);
+  // And the same with the roles swapped (the kernel is symmetric).
+  const PairForce g = triangle_pair_force(t, c, Ep);
+  EXPECT_NEAR(g.energy, ref, strip_tolerance(2.9e-12, 0.2) * ref);
+}
+
+// Strips of depth 1e-3 to 1e-13 of the element size L between a contactor face and a target
+// face that are nearly parallel (slope 1e-3 of the depth), rotated and moved away from the
+// origin, the contactor face shorter than the target's (P inside one sub-triangle of t) or
+// overhanging one end (P reaching t's corner, cut by its sub-triangle line). The energy
+// matches the long-double reference to the rounding bound and is never negative.
+TEST(NarrowPhase, ThinStripEnergyMatchesLongDoubleReference) {
+  const double L = 0.2, Ep = 5.556e12, angle = 0.37, ox = 12.3, oy = -4.56;
+  auto place = [&](double x, double y) {
+    return Vec2{ox + std::cos(angle) * x - std::sin(angle) * y,
+                oy + std::sin(angle) * x + std::cos(angle) * y};
+  };
+  int checked = 0;
+  for (const double overhang : {-0.1, 0.15}) {  // contactor's left end inside / outside t
+    for (int e = 3; e <= 13; ++e) {
+      const double d = L * std::pow(10.0, -e);
+      const Tri t = {place(0.0, 0.0), place(0.3 * L, -0.9 * L), place(L, 0.0)};
+      const Tri c = {place(-overhang * L, -d), place(0.8 * L, -d * (1.0 - 1e-3)),
+                     place(0.35 * L, 0.7 * L)};
+      const PairForce f = triangle_pair_force(c, t, Ep);
+      const double ref = static_cast<double>(energy_ld(c, t, Ep));
+      ASSERT_GT(ref, 0.0) << "d/L = 1e-" << e;
+      EXPECT_GE(f.energy, 0.0) << "d/L = 1e-" << e;
+      const double rel = std::abs(f.energy - ref) / ref;
+      EXPECT_LE(rel, strip_tolerance(d, L)) << "d/L = 1e-" << e << " overhang " << overhang
+                                            << ": energy " << f.energy << " J, reference " << ref;
+      std::printf(
+          "[thin strip] overhang %5.2f d/L 1e-%02d energy %.6e J reference %.6e J "
+          "relative error %.1e (allowed %.1e)\n",
+          overhang, e, f.energy, ref, rel, strip_tolerance(d, L));
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 22);
+}
+
+// Energy is never negative, whatever the overlap: random thin and deep overlaps.
+TEST(NarrowPhase, EnergyNeverNegative) {
+  std::mt19937_64 rng(777);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), lg(-14.0, -1.0);
+  const double Ep = 1e12;
+  int touching = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    // c's base on y = -depth (slightly tilted), t's top edge on y = 0, random lengths.
+    const double d = std::pow(10.0, lg(rng));
+    const Tri t = {Vec2{u(rng) - 1.0, 0.0}, Vec2{u(rng), -0.5 - 0.4 * u(rng)},
+                   Vec2{u(rng) + 1.0, 0.0}};
+    const Tri c = {Vec2{u(rng) - 0.5, -d * (1.0 + 0.01 * u(rng))},
+                   Vec2{u(rng) + 0.5, -d * (1.0 + 0.01 * u(rng))}, Vec2{u(rng), 0.6}};
+    const PairForce f = triangle_pair_force(c, t, Ep);
+    ASSERT_GE(f.energy, 0.0) << "trial " << trial << " depth " << d;
+    if (f.area > 0.0) ++touching;
+  }
+  EXPECT_GT(touching, 3000);
 }
 
 TEST(Friction, SticksBelowTheCone) {

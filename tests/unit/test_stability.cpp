@@ -207,10 +207,7 @@ TEST(Stability, SoftBlocksOneGigapascalStand) {
   check_arch_stands("E = 1 GPa", {"material.young=1e9"}, 0.05);
 }
 
-// DISABLED (open finding of issue 8, docs/robustness.md): the energy balance of this case
-// misses the 1% bound (e.g. 0.73 of a 1e-5 J peak at density 1); not yet understood, so the
-// test is kept as it is, not loosened.
-TEST(Stability, DISABLED_StiffBlocksTwoHundredGigapascalStand) {
+TEST(Stability, StiffBlocksTwoHundredGigapascalStand) {
   check_arch_stands("E = 200 GPa", {"material.young=200e9"}, 0.03);
 }
 
@@ -218,10 +215,7 @@ TEST(Stability, PenaltyFactorThousandStands) {
   check_arch_stands("penalty factor 1000", {"contact.penalty_factor=1000"}, 0.03);
 }
 
-// DISABLED (open finding of issue 8, docs/robustness.md): the energy balance of this case
-// misses the 1% bound (e.g. 0.73 of a 1e-5 J peak at density 1); not yet understood, so the
-// test is kept as it is, not loosened.
-TEST(Stability, DISABLED_DensityOneStands) {
+TEST(Stability, DensityOneStands) {
   // dt scales with sqrt(rho): 45 times smaller than at 2000 kg/m3, and so does every elastic
   // time scale (the gravity load scales with rho too), so 4 ms here is 0.18 s at 2000.
   check_arch_stands("density 1", {"material.density=1"}, 0.004);
@@ -327,10 +321,7 @@ Model sliver_model(double min_angle_deg) {
   return m;
 }
 
-// DISABLED (open finding of issue 8, docs/robustness.md): the energy balance of this case
-// misses the 1% bound (e.g. 0.73 of a 1e-5 J peak at density 1); not yet understood, so the
-// test is kept as it is, not loosened.
-TEST(Stability, DISABLED_SliverTrianglesStand) {
+TEST(Stability, SliverTrianglesStand) {
   Simulation sim;
   sim.model = sliver_model(2.0);
   EXPECT_NEAR(worst_triangle_angle_deg(sim.model), 2.0, 1e-9);
