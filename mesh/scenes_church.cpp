@@ -41,6 +41,9 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kFixedCoarsening = 3.0;
+// Largest support width, pier width, height and arch thickness accepted, as a multiple of the
+// largest span (dimensionless; real churches stay below ~3).
+constexpr double kMaxSizeToSpan = 100.0;
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -134,6 +137,22 @@ Scene build_church_scene(const Config& config) {
   if (!(ecc >= 0.0)) geometry_error(config, "model.eccentricity", ecc, "expected a value >= 0");
   if (!(dtheta > 0.0 && dtheta < 0.5 * kPi))
     geometry_error(config, "model.voussoir_angle", mc.voussoir_angle, "expected (0, 90) degrees");
+  // Absurd sizes. Supports are outlined at the arches' element size before any triangle
+  // budget can be estimated (mesh/scene.cpp), so a 4.3e9 m outer buttress (fuzzing, issue 8)
+  // exhausted memory in the generator. No church has a support or a height of more than
+  // kMaxSizeToSpan times its largest span; a thickness that large is no arch either.
+  const double span_max = *std::max_element(spans.begin(), spans.end());
+  const double size_limit = kMaxSizeToSpan * span_max;
+  auto refuse_above_limit = [&](const char* key, double value) {
+    if (!(value <= size_limit))
+      geometry_error(config, key, value,
+                     "expected at most " + fmt(kMaxSizeToSpan) + " x the largest span (" +
+                         fmt(span_max) + " m), i.e. " + fmt(size_limit) + " m");
+  };
+  refuse_above_limit("model.outer_width", outer);
+  if (ns > 1) refuse_above_limit("model.pier_width", pier);
+  refuse_above_limit("model.height", height);
+  refuse_above_limit("model.thickness", t);
   if (hc > 0.0 && height / hc > 10000.0)
     geometry_error(config, "model.courses", hc, "makes more than 10000 courses per support");
 

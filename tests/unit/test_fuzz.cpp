@@ -115,11 +115,24 @@ TEST(FuzzFindings, BlockHugeHeight) {
   expect_refused_or_accepted(check_with("block.toml", {"model.height=40e9"}));
 }
 
-// mesh/scenes_church.cpp: outer_width 4294967296 m -> std::bad_alloc (exit 1).
-// DISABLED (open finding of issue 8): a church with a 4.3e9 m outer buttress is accepted and
-// meshed instead of being refused with a message; the geometry check is still to be written.
-TEST(FuzzFindings, DISABLED_ChurchHugeOuterWidth) {
-  expect_refused_or_accepted(check_with("church_a.toml", {"model.outer_width=4294967296"}));
+// mesh/scenes_church.cpp: outer_width 4294967296 m -> std::bad_alloc (exit 1): the supports
+// were outlined at the element size before any triangle budget. Now refused up front (exit 2)
+// naming the key, the value and the limit (100 x the largest span, 600 m for church_a); so are
+// a pier just over the limit and an absurd height; a wide but sane buttress (3 m) is accepted.
+TEST(FuzzFindings, ChurchHugeOuterWidth) {
+  const ProcessResult r = check_with("church_a.toml", {"model.outer_width=4294967296"});
+  expect_refused_or_accepted(r);
+  EXPECT_TRUE(r.exited && r.status == 2) << r.describe();
+  EXPECT_NE(r.err.find("model.outer_width = 4294967296"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("at most 100 x the largest span (6 m)"), std::string::npos) << r.err;
+  for (const std::string& set :
+       {std::string("model.pier_width=601"), std::string("model.height=1e12")}) {
+    const ProcessResult q = check_with("church_a.toml", {set});
+    EXPECT_TRUE(q.exited && q.status == 2) << set << ": " << q.describe();
+    EXPECT_NE(q.err.find(set.substr(0, set.find('=')) + " = "), std::string::npos) << q.err;
+  }
+  const ProcessResult ok = check_with("church_a.toml", {"model.outer_width=3"});
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.describe() << "\n" << ok.err;
 }
 
 // mesh/scenes_polygons.cpp: block 0 = (-0.25, 0), (0.25, 0), (0.25, 2147483648), (-1.75, -0.25),
