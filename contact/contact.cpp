@@ -38,7 +38,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <stdexcept>
 
 #include "contact/broad_phase.hpp"
 #include "contact/friction.hpp"
@@ -85,8 +87,14 @@ struct ContactSystem::Impl {
 
   std::int64_t active = 0;
   std::int64_t detections = 0;
+  // Positions of the free participant nodes (Participants::free_nodes) at the last detection:
+  // the broad phase's reference, kept here for save_state (its copy is private).
+  std::vector<double> detected_x, detected_y;
 
   std::vector<PairResult> results;  // per-pair slots of the multi-threaded path
+
+  void index_pairs(const Model& model);
+  void record_detection(const Nodes& nodes);
 
   template <bool kFriction>
   bool evaluate(std::size_t p, const Nodes& n, double dt, PairResult& r);
@@ -118,6 +126,8 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
   s.kt.clear();
   s.active = 0;
   s.detections = 0;
+  s.detected_x.clear();
+  s.detected_y.clear();
 
   // Reference geometry of the participants: longest boundary edge and the height over it
   // (for k_t), smallest face height per block (for the stable step).
@@ -156,19 +166,139 @@ void ContactSystem::detect(const Model& model) {
   std::swap(s.pairs, s.next_pairs);
   std::swap(s.sx, s.next_sx);
   std::swap(s.sy, s.next_sy);
-  const std::size_t np = s.pairs.size();
-  s.kt.resize(np);
-  for (auto* v : {&s.pc0, &s.pc1, &s.pc2, &s.pt0, &s.pt1, &s.pt2}) v->resize(np);
-  const Triangles& t = model.tris;
-  const double scale = kTangentialStiffnessRatio * s.penalty * s.thickness;
-  for (std::size_t p = 0; p < np; ++p) {
-    const Index a = s.pairs[p].a, b = s.pairs[p].b;
-    s.pc0[p] = t.n0[a], s.pc1[p] = t.n1[a], s.pc2[p] = t.n2[a];
-    s.pt0[p] = t.n0[b], s.pt1[p] = t.n1[b], s.pt2[p] = t.n2[b];
-    s.kt[p] =
-        scale * (3.0 / s.height[a] + 3.0 / s.height[b]) * std::min(s.edge_len[a], s.edge_len[b]);
-  }
+  s.index_pairs(model);
+  s.record_detection(model.nodes);
   ++s.detections;
+}
+
+// Per-pair node indices and tangential stiffness of the current pair list.
+void ContactSystem::Impl::index_pairs(const Model& model) {
+  const std::size_t np = pairs.size();
+  kt.resize(np);
+  for (auto* v : {&pc0, &pc1, &pc2, &pt0, &pt1, &pt2}) v->resize(np);
+  const Triangles& t = model.tris;
+  const double scale = kTangentialStiffnessRatio * penalty * thickness;
+  for (std::size_t p = 0; p < np; ++p) {
+    const Index a = pairs[p].a, b = pairs[p].b;
+    pc0[p] = t.n0[a], pc1[p] = t.n1[a], pc2[p] = t.n2[a];
+    pt0[p] = t.n0[b], pt1[p] = t.n1[b], pt2[p] = t.n2[b];
+    kt[p] = scale * (3.0 / height[a] + 3.0 / height[b]) * std::min(edge_len[a], edge_len[b]);
+  }
+}
+
+void ContactSystem::Impl::record_detection(const Nodes& nodes) {
+  const std::vector<Index>& free_nodes = broad.participants().free_nodes;
+  detected_x.resize(free_nodes.size());
+  detected_y.resize(free_nodes.size());
+  for (std::size_t k = 0; k < free_nodes.size(); ++k) {
+    detected_x[k] = nodes.x[free_nodes[k]];
+    detected_y[k] = nodes.y[free_nodes[k]];
+  }
+}
+
+// State bytes: u64 tag, u8 ready, u8 detected, i64 detections, i64 active, then the arrays
+// detected_x, detected_y, pairs, sx, sy (each u64 count then the items).
+namespace {
+
+constexpr std::uint64_t kStateTag = 0x564f555353434f31ull;  // "VOUSSCO1"
+
+void put_bytes(std::vector<char>& out, const void* p, std::size_t n) {
+  const std::size_t at = out.size();
+  out.resize(at + n);
+  if (n > 0) std::memcpy(out.data() + at, p, n);
+}
+template <class T>
+void put(std::vector<char>& out, const T& v) {
+  put_bytes(out, &v, sizeof v);
+}
+template <class T>
+void put_array(std::vector<char>& out, const std::vector<T>& v) {
+  put<std::uint64_t>(out, v.size());
+  put_bytes(out, v.data(), v.size() * sizeof(T));
+}
+
+struct StateReader {
+  const std::vector<char>& in;
+  std::size_t pos = 0;
+  [[noreturn]] static void fail(const std::string& why) {
+    throw std::runtime_error("contact state: " + why);
+  }
+  template <class T>
+  T get() {
+    T v{};
+    if (sizeof v > in.size() - pos) fail("truncated");
+    std::memcpy(&v, in.data() + pos, sizeof v);
+    pos += sizeof v;
+    return v;
+  }
+  template <class T>
+  std::vector<T> get_array() {
+    const auto n = get<std::uint64_t>();
+    if (n > (in.size() - pos) / sizeof(T)) fail("truncated");
+    std::vector<T> v(n);
+    if (n > 0) std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
+    pos += n * sizeof(T);
+    return v;
+  }
+};
+
+}  // namespace
+
+std::vector<char> ContactSystem::save_state() const {
+  const Impl& s = *impl_;
+  std::vector<char> out;
+  put(out, kStateTag);
+  put<std::uint8_t>(out, s.ready ? 1 : 0);
+  put<std::uint8_t>(out, s.detections > 0 ? 1 : 0);
+  put<std::int64_t>(out, s.detections);
+  put<std::int64_t>(out, s.active);
+  put_array(out, s.detected_x);
+  put_array(out, s.detected_y);
+  put_array(out, s.pairs);
+  put_array(out, s.sx);
+  put_array(out, s.sy);
+  return out;
+}
+
+void ContactSystem::restore_state(const Model& model, const std::vector<char>& bytes) {
+  Impl& s = *impl_;
+  StateReader in{bytes};
+  if (in.get<std::uint64_t>() != kStateTag) in.fail("not a contact state");
+  const bool ready = in.get<std::uint8_t>() != 0, detected = in.get<std::uint8_t>() != 0;
+  const auto detections = in.get<std::int64_t>(), active = in.get<std::int64_t>();
+  std::vector<double> dx = in.get_array<double>(), dy = in.get_array<double>();
+  std::vector<IndexPair> pairs = in.get_array<IndexPair>();
+  std::vector<double> sx = in.get_array<double>(), sy = in.get_array<double>();
+  if (in.pos != bytes.size()) in.fail("unexpected data after the state");
+  if (ready != s.ready) in.fail("written with contact " + std::string(ready ? "on" : "off"));
+  if (!ready) return;
+  const std::vector<Index>& free_nodes = s.broad.participants().free_nodes;
+  if (sx.size() != pairs.size() || sy.size() != pairs.size())
+    in.fail("slip and pair counts differ");
+  if (!detected) {
+    if (!pairs.empty()) in.fail("pairs without a detection");
+    return;  // the first step detects, as in the uninterrupted run
+  }
+  if (dx.size() != free_nodes.size() || dy.size() != free_nodes.size())
+    in.fail("participant node count differs from the model");
+  // The last detection again, from its own positions: the same candidate list (a function of
+  // the positions only) and the same reference for needs_detection.
+  Nodes at_detection;
+  at_detection.x = model.nodes.x;
+  at_detection.y = model.nodes.y;
+  for (std::size_t k = 0; k < free_nodes.size(); ++k) {
+    at_detection.x[free_nodes[k]] = dx[k];
+    at_detection.y[free_nodes[k]] = dy[k];
+  }
+  s.broad.detect(at_detection, s.pairs);
+  if (s.pairs != pairs) in.fail("candidate pairs differ from those of the saved detection");
+  s.sx = std::move(sx);
+  s.sy = std::move(sy);
+  s.index_pairs(model);
+  s.detected_x = std::move(dx);
+  s.detected_y = std::move(dy);
+  s.detections = detections;
+  s.active = active;
 }
 
 namespace {

@@ -51,6 +51,17 @@ class ContactSystem {
   double penalty() const;  // Ep in use [Pa] (ContactParams::penalty, or 100 x Lame lambda if 0)
   double buffer() const;   // NBS buffer in use [m]
 
+  // Checkpoints (io/checkpoint.hpp). save_state: what evolves here -- the candidate pairs and
+  // their friction slip, the positions of the free participant nodes at the last detection
+  // (the broad phase's reference for needs_detection), the detection and active-pair counts --
+  // as opaque bytes (native byte order, like the checkpoint). restore_state, on a system set up
+  // for the same model with the checkpoint's node positions in place: re-runs the last
+  // detection from the saved positions (same candidate list, same reference, so the next
+  // detections happen at the same steps) and puts the slip back, so the run continues bit for
+  // bit. Throws std::runtime_error when the bytes do not fit this model.
+  std::vector<char> save_state() const;
+  void restore_state(const Model& model, const std::vector<char>& bytes);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

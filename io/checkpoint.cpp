@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <concepts>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -26,42 +25,9 @@ constexpr char kMagic[] = "VOUSSOIR-CKPT\n";  // 14 characters, no terminator wr
 constexpr std::size_t kMagicSize = sizeof(kMagic) - 1;
 constexpr std::uint32_t kVersion = 1;
 constexpr std::uint32_t kByteOrderTag = 0x01020304u;
-
-// The contact state interface requested from contact/ (io/checkpoint.hpp "Contact state"),
-// detected at compile time so that this file builds with and without it.
-template <class C>
-concept HasContactState = requires(const C& c, C& m, const Model& model,
-                                   const std::vector<char>& bytes) {
-  { c.save_state() } -> std::convertible_to<std::vector<char>>;
-  m.restore_state(model, bytes);
-};
-
-template <class C>
-std::vector<char> save_contact(const C& contact) {
-  if constexpr (HasContactState<C>) {
-    return contact.save_state();
-  } else {
-    return {};
-  }
-}
-
-template <class C>
-void restore_contact(C& contact, const Model& model, const std::vector<char>& bytes,
-                     const std::string& path) {
-  if constexpr (HasContactState<C>) {
-    try {
-      contact.restore_state(model, bytes);
-    } catch (const std::exception& e) {
-      throw DeckError("restart file '" + path + "': " + e.what());
-    }
-  } else {
-    // A fresh set-up re-detects at the first step: exact without friction (header).
-    (void)contact;
-    (void)model;
-    (void)bytes;
-    (void)path;
-  }
-}
+// Contact kind byte: 1 = ContactSystem::save_state bytes follow. (0 was written by builds
+// without that interface, frictionless runs only; such files are refused.)
+constexpr std::uint8_t kContactBytes = 1;
 
 // FNV-1a, 64 bit.
 struct Fnv {
@@ -164,7 +130,7 @@ void write_file_atomically(const std::string& path, const std::string& data) {
 }  // namespace
 
 bool contact_history_saved() {
-  return HasContactState<ContactSystem>;
+  return true;  // ContactSystem::save_state/restore_state (contact/contact.hpp)
 }
 
 std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
@@ -196,11 +162,6 @@ std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
 
 void write_checkpoint(const std::string& path, const Simulation& sim, std::uint64_t fingerprint,
                       double friction, const std::vector<double>& driver_state) {
-  if (sim.ctx.contact_on && friction > 0.0 && !contact_history_saved())
-    throw OutputError("cannot write checkpoint '" + path +
-                      "': the friction history of the contact pairs cannot be saved by this "
-                      "build (ContactSystem has no save_state); checkpoints need "
-                      "contact.friction = 0 here");
   Out o;
   o.bytes(kMagic, kMagicSize);
   o.value(kVersion);
@@ -219,8 +180,8 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
   o.array(n.vx);
   o.array(n.vy);
   o.array(sim.viscous_piola);
-  o.value<std::uint8_t>(contact_history_saved() ? 1 : 0);
-  o.array(save_contact(sim.contact));
+  o.value<std::uint8_t>(kContactBytes);
+  o.array(sim.contact.save_state());
   o.array(driver_state);
   Fnv sum;
   sum.bytes(o.buf.data(), o.buf.size());
@@ -282,7 +243,7 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     in.fail("node count differs from the model");
   if (!piola.empty() && piola.size() != 4 * std::size_t(sim.model.tris.size()))
     in.fail("triangle count differs from the model");
-  if (contact_kind != (contact_history_saved() ? 1 : 0))
+  if (contact_kind != kContactBytes)
     in.fail("contact state written by a build with another contact interface");
 
   sim.step = step;
@@ -296,7 +257,11 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   n.vx = std::move(vx);
   n.vy = std::move(vy);
   sim.viscous_piola = std::move(piola);
-  restore_contact(sim.contact, sim.model, contact, path);
+  try {
+    sim.contact.restore_state(sim.model, contact);
+  } catch (const std::exception& e) {
+    in.fail(e.what());
+  }
   return driver;
 }
 

@@ -21,18 +21,10 @@
 // extended.
 //
 // Contact state. The ContactSystem keeps its candidate pairs, the friction slip of each pair
-// and the broad phase's positions of the last detection behind a private Impl
-// (contact/contact.cpp), so this file can only save what its public interface gives:
-//   - if ContactSystem has `std::vector<char> save_state() const` and
-//     `void restore_state(const Model&, const std::vector<char>&)` (requested from the contact
-//     stage for this issue), the opaque bytes are saved and restored: exact in every case;
-//   - otherwise the contact system restarts from a fresh set-up and re-detects at the first
-//     step. That is exact when friction is off: the narrow phase adds the forces and energies
-//     of the overlapping pairs in sorted pair order, every valid candidate list contains every
-//     overlapping pair (contact/broad_phase.hpp, laziness), so any two valid lists give the
-//     same sums bit for bit, whenever the detections happen; with mu = 0 no other state exists.
-//     With friction the slip history would be lost, so write_checkpoint refuses (OutputError)
-//     and contact_history_saved() tells drivers beforehand.
+// and the broad phase's positions of the last detection behind a private Impl; its
+// save_state() bytes are stored as they are and restore_state() puts them back (it re-runs the
+// last detection from the saved positions, so candidate list, detection steps and slip
+// history continue exactly; contact/contact.hpp). With or without friction.
 //
 // Format (version 1): binary, native byte order and IEEE doubles (restart on the machine type
 // that wrote it; the header records the byte order and a mismatch is refused):
@@ -40,8 +32,9 @@
 //   u64 fingerprint, i64 step, f64 time, dt, prev_body_ax, prev_body_ay,
 //   7 x f64 ledger (kinetic, strain, contact, external_work, damping_dissipated,
 //   friction_dissipated, max_energy), arrays x, y, vx, vy, viscous_piola, u8 contact kind
-//   (1: ContactSystem bytes follow, 0: re-detect), contact bytes, driver values (each array:
-//   u64 count then the items), u64 FNV-1a checksum of everything before it.
+//   (1: ContactSystem bytes follow; 0, from builds before save_state, is refused), contact
+//   bytes, driver values (each array: u64 count then the items), u64 FNV-1a checksum of
+//   everything before it.
 // Written to PATH.tmp, flushed and closed, then renamed over PATH (atomic on POSIX file
 // systems): a run killed while writing leaves the previous checkpoint intact.
 
@@ -53,8 +46,8 @@
 
 namespace voussoir {
 
-// True when checkpoints keep the contact friction history (the ContactSystem state interface
-// is present); false means only frictionless runs can be checkpointed.
+// True: checkpoints keep the contact friction history (ContactSystem::save_state). Kept for
+// callers written when it could be false (frictionless runs only).
 bool contact_history_saved();
 
 // Fingerprint of everything make_simulation rebuilds from the deck: node and triangle counts,
@@ -64,8 +57,8 @@ bool contact_history_saved();
 std::uint64_t simulation_fingerprint(const Simulation& sim, double friction);
 
 // Writes the checkpoint atomically (PATH.tmp then rename). Throws OutputError naming the path
-// when the file cannot be written, or when the contact state cannot be saved (see above:
-// friction on and no contact state interface).
+// when the file cannot be written. `friction` is not used (the contact state carries what
+// friction needs; the fingerprint takes mu).
 void write_checkpoint(const std::string& path, const Simulation& sim, std::uint64_t fingerprint,
                       double friction, const std::vector<double>& driver_state);
 

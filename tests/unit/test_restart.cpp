@@ -5,10 +5,9 @@
 // lambda* of 0.29), so blocks move and contacts open and close, with a 0.1 mm contact buffer so
 // that the broad phase re-detects several times after the restart point.
 //
-// Contact friction history: restored only when ContactSystem offers save_state/restore_state
-// (io/checkpoint.hpp "Contact state"); until then checkpoints are limited to frictionless runs,
-// the friction tests are skipped (with the reason) and `--checkpoint-every` with friction is
-// refused with exit status 2.
+// Contact state (io/checkpoint.hpp "Contact state"): ContactSystem::save_state/restore_state
+// carry the candidate pairs, the friction slip history and the last detection's positions, so
+// runs with and without friction restart bit for bit.
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -73,6 +72,10 @@ void expect_same_state(const Simulation& a, const Simulation& b) {
   EXPECT_TRUE(same_bits(la.damping_dissipated, lb.damping_dissipated));
   EXPECT_TRUE(same_bits(la.friction_dissipated, lb.friction_dissipated));
   EXPECT_TRUE(same_bits(la.max_energy, lb.max_energy));
+  // The broad phase detected at the same steps (its reference positions were restored).
+  EXPECT_EQ(a.contact.detections(), b.contact.detections());
+  EXPECT_EQ(a.contact.candidate_pairs(), b.contact.candidate_pairs());
+  EXPECT_EQ(a.contact.active_pairs(), b.contact.active_pairs());
 }
 
 std::vector<double> read_series(const std::string& file, const std::string& name) {
@@ -126,8 +129,11 @@ void check_restart_identity(double friction, double stop, const std::string& tag
   RunOptions full;
   full.output = s / "full.h5";
   const Simulation a = run(arch(friction, kEndTime), full, s / "full.json");
-  // The restart must cover re-detections after the restart point.
+  // The restart must cover re-detections after the restart point, and friction must work.
   ASSERT_GE(a.contact.detections(), 4);
+  if (friction > 0.0) {
+    EXPECT_GT(a.ledger.friction_dissipated, 0.0);
+  }
 
   RunOptions first;
   first.output = s / "first.h5";
@@ -168,9 +174,6 @@ TEST(Restart, FrictionlessRunRestartsBitForBit) {
 }
 
 TEST(Restart, RunWithFrictionRestartsBitForBit) {
-  if (!contact_history_saved())
-    GTEST_SKIP() << "ContactSystem has no save_state/restore_state yet: the friction history "
-                    "cannot be checkpointed (io/checkpoint.hpp)";
   check_restart_identity(0.6, 0.005, "mu06");
 }
 
@@ -310,15 +313,19 @@ TEST(Restart, ProgramOptions) {
   EXPECT_NE(missing.err.find("no such file"), std::string::npos) << missing.err;
   const auto negative = with({"--checkpoint-every", "-1"});
   EXPECT_TRUE(negative.exited && negative.status == 2) << negative.describe();
-  if (!contact_history_saved()) {
-    // With friction and no contact state interface: refused up front, not after an hour.
-    std::vector<std::string> args = {
-        VOUSSOIR_BINARY,      "run",  deck, "-q", "--set", "mesh.through_thickness=1",
-        "--checkpoint-every", "0.001"};
-    const auto refused = testing::run_process(args, {}, s / "child");
-    EXPECT_TRUE(refused.exited && refused.status == 2) << refused.describe();
-    EXPECT_NE(refused.err.find("contact.friction"), std::string::npos) << refused.err;
-  }
+  // With friction (the deck's mu = 0.6): checkpoints are written and a restart continues.
+  auto with_friction = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {VOUSSOIR_BINARY,           "run", deck, "-q", "--set",
+                                     "mesh.through_thickness=1"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return testing::run_process(args, {}, s / "child");
+  };
+  const auto written = with_friction(
+      {"--set", "solver.end_time=0.002", "-o", s / "f.h5", "--checkpoint-every", "0.001"});
+  ASSERT_TRUE(written.exited && written.status == 0) << written.describe() << written.err;
+  const auto resumed = with_friction(
+      {"--set", "solver.end_time=0.003", "-o", s / "g.h5", "--restart", s / "f.h5.ckpt"});
+  EXPECT_TRUE(resumed.exited && resumed.status == 0) << resumed.describe() << resumed.err;
 }
 
 }  // namespace
