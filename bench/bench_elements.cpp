@@ -90,8 +90,8 @@ void BM_Elements(benchmark::State& state) {
   double sink = 0.0;
   for (auto _ : state) {
     clear_forces(sim.model.nodes);
-    const ElementStageResult r =
-        add_element_forces(sim.model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr);
+    const ElementStageResult r = add_element_forces(
+        sim.model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr, &sim.element_work);
     sink += r.strain_energy;
   }
   benchmark::DoNotOptimize(sink);

@@ -2,8 +2,12 @@
 
 #include "core/cst.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 namespace voussoir {
 
@@ -13,97 +17,229 @@ Stress2 triangle_cauchy_stress(const Model& model, Index e, const CstLaw& law) {
 
 namespace {
 
-// Triangles per chunk of the element loop: gather node data into small local arrays, run the
-// kernel over the chunk (no indirect writes, so it vectorizes: 4 triangles per AVX2 op), then
-// scatter the forces. Measured ~1.5x over the plain gather-compute-scatter loop (damped,
-// 1e5 triangles); 16, 32 and 64 perform alike.
-constexpr int kChunk = 32;
+// Threads. The one-thread loop runs over chunks of kElementChunk triangles: gather node data
+// into small local arrays, run the kernel over the chunk (no indirect writes, so it
+// vectorizes: 4 triangles per AVX2 op), then scatter the forces into fx, fy. Measured ~1.5x
+// over the plain gather-compute-scatter loop (damped, 1e5 triangles); 16, 32 and 64 perform
+// alike. The threaded path runs the same chunks (same function, so the same code and the same
+// order of the in-chunk sums) on the threads, each chunk writing its corner forces to its own
+// slots of ElementWorkspace::corner_fx/fy; then each node sums its corner slots in ascending
+// triangle order (CSR node_begin/node_corner). That is exactly the sequence of additions the
+// scatter makes into fx[i], and the chunk sums are added in chunk order: every force and
+// energy is bit-identical to the one-thread loop for any thread count, with no atomics.
+// Rejected: colouring (a different addition order from the one-thread loop, so the small
+// scenes, which stay on one thread, would change results), per-thread force arrays (the
+// reduction order would depend on the thread count).
+//
+// Fewer free triangles than this stay on one thread: a parallel region costs a few
+// microseconds idle, much more when the cores are shared (contact/contact.cpp
+// kParallelPairs); 8192 triangles are ~150 us of one-thread work.
+constexpr Index kParallelTriangles = 8192;
+constexpr int kChunk = kElementChunk;
 
-// The element loop; kViscous: read and update the viscous Piola buffer (ledger).
-template <bool kViscous>
-ElementStageResult element_loop(Model& model, const CstLaw& law, double* __restrict viscous) {
-  Nodes& nodes = model.nodes;
-  const Triangles& tris = model.tris;
-  // Hot arrays as local pointers (STYLE.md "Hot loops").
-  const double* __restrict x = nodes.x.data();
-  const double* __restrict y = nodes.y.data();
-  const double* __restrict vx = nodes.vx.data();
-  const double* __restrict vy = nodes.vy.data();
-  double* __restrict fx = nodes.fx.data();
-  double* __restrict fy = nodes.fy.data();
-  const Index* __restrict n0 = tris.n0.data();
-  const Index* __restrict n1 = tris.n1.data();
-  const Index* __restrict n2 = tris.n2.data();
-  const double* __restrict b00 = tris.b00.data();
-  const double* __restrict b01 = tris.b01.data();
-  const double* __restrict b10 = tris.b10.data();
-  const double* __restrict b11 = tris.b11.data();
-  const double* __restrict area0 = tris.area0.data();
-  const double thickness = model.out_of_plane;
-  const std::size_t nt = std::size_t(tris.size());
+bool threads_available() { return omp_get_max_threads() > 1 && !omp_in_parallel(); }
 
-  // Chunk buffers: node data of the three corners, and the forces on them.
-  alignas(64) double cx[3][kChunk], cy[3][kChunk], cvx[3][kChunk], cvy[3][kChunk];
-  alignas(64) double cfx[3][kChunk], cfy[3][kChunk];
+// Hot arrays of the element stage as flat pointers (STYLE.md "Hot loops").
+struct ElementArrays {
+  const double *x, *y, *vx, *vy;
+  const Index *n0, *n1, *n2;
+  const double *b00, *b01, *b10, *b11, *area0;
+  double thickness;
+  std::size_t nt;
+};
 
+ElementArrays arrays_of(const Model& model) {
+  const Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  return ElementArrays{n.x.data(),   n.y.data(),   n.vx.data(),  n.vy.data(),
+                       t.n0.data(),  t.n1.data(),  t.n2.data(),  t.b00.data(),
+                       t.b01.data(), t.b10.data(), t.b11.data(), t.area0.data(),
+                       model.out_of_plane, std::size_t(t.size())};
+}
+
+struct ChunkSums {
   double energy = 0.0, power = 0.0, previous_power = 0.0;
+};
+
+// Forces on the corners of triangles [c0, c0 + len) into cfx/cfy (layout [corner][j]) and
+// the chunk's energy sums; kViscous: read and update the viscous Piola buffer (ledger).
+// Not inlined, so that both paths run the very same code (same in-chunk summation order).
+template <bool kViscous>
+[[gnu::noinline]] ChunkSums chunk_forces(const ElementArrays& a, const CstLaw& law,
+                                         double* __restrict viscous, Index c0, int len,
+                                         double* __restrict cfx, double* __restrict cfy) {
+  const double* __restrict x = a.x;
+  const double* __restrict y = a.y;
+  const double* __restrict vx = a.vx;
+  const double* __restrict vy = a.vy;
+  const Index* __restrict n0 = a.n0;
+  const Index* __restrict n1 = a.n1;
+  const Index* __restrict n2 = a.n2;
+  const double* __restrict b00 = a.b00;
+  const double* __restrict b01 = a.b01;
+  const double* __restrict b10 = a.b10;
+  const double* __restrict b11 = a.b11;
+  const double* __restrict area0 = a.area0;
+  const double thickness = a.thickness;
+  const std::size_t nt = a.nt;
+  // Node data of the three corners.
+  alignas(64) double cx[3][kChunk], cy[3][kChunk], cvx[3][kChunk], cvy[3][kChunk];
+  for (int j = 0; j < len; ++j) {  // gather
+    const Index e = c0 + j, i0 = n0[e], i1 = n1[e], i2 = n2[e];
+    cx[0][j] = x[i0], cx[1][j] = x[i1], cx[2][j] = x[i2];
+    cy[0][j] = y[i0], cy[1][j] = y[i1], cy[2][j] = y[i2];
+    cvx[0][j] = vx[i0], cvx[1][j] = vx[i1], cvx[2][j] = vx[i2];
+    cvy[0][j] = vy[i0], cvy[1][j] = vy[i1], cvy[2][j] = vy[i2];
+  }
+  double en = 0.0, pw = 0.0, pp = 0.0;
+#pragma omp simd reduction(+ : en, pw, pp)
+  for (int j = 0; j < len; ++j) {  // compute
+    const Index e = c0 + j;
+    TriangleState s;
+    for (int c = 0; c < 3; ++c) {
+      s.x[c] = cx[c][j], s.y[c] = cy[c][j];
+      s.vx[c] = cvx[c][j], s.vy[c] = cvy[c][j];
+    }
+    const EdgeInverse b{b00[e], b01[e], b10[e], b11[e]};
+    const CstForce f = cst_force(s, b, area0[e] * thickness, law);
+    for (int c = 0; c < 3; ++c) cfx[c * kChunk + j] = f.fx[c], cfy[c * kChunk + j] = f.fy[c];
+    en += f.energy;
+    pw += f.damping_power;
+    if constexpr (kViscous) {
+      // Power of the previous step's viscous stress at the current velocities; then keep
+      // this step's.
+      double* __restrict pv = viscous + e;
+      pp += pv[0] * f.rate[0] + pv[nt] * f.rate[1] + pv[2 * nt] * f.rate[2] +
+            pv[3 * nt] * f.rate[3];
+      pv[0] = f.viscous[0], pv[nt] = f.viscous[1];
+      pv[2 * nt] = f.viscous[2], pv[3 * nt] = f.viscous[3];
+    }
+  }
+  return ChunkSums{en, pw, pp};
+}
+
+ElementStageResult result_of(const ChunkSums& s) {
+  ElementStageResult out;
+  out.strain_energy = s.energy;
+  out.damping_power = s.power;
+  out.previous_damping_power = s.previous_power;
+  return out;
+}
+
+// The one-thread element loop: chunks of the free blocks in order, scatter after each.
+template <bool kViscous>
+ElementStageResult element_loop(Model& model, const CstLaw& law, double* viscous) {
+  const ElementArrays a = arrays_of(model);
+  double* __restrict fx = model.nodes.fx.data();
+  double* __restrict fy = model.nodes.fy.data();
+  alignas(64) double cfx[3][kChunk], cfy[3][kChunk];
+  ChunkSums sum;
   // Triangles of one block are contiguous: flat loops per free block.
   for (const Block& block : model.blocks) {
     if (block.fixed) continue;
     const Index end = block.first_tri + block.tri_count;
     for (Index c0 = block.first_tri; c0 < end; c0 += kChunk) {
       const int len = int(std::min<Index>(kChunk, end - c0));
-      for (int j = 0; j < len; ++j) {  // gather
-        const Index e = c0 + j, i0 = n0[e], i1 = n1[e], i2 = n2[e];
-        cx[0][j] = x[i0], cx[1][j] = x[i1], cx[2][j] = x[i2];
-        cy[0][j] = y[i0], cy[1][j] = y[i1], cy[2][j] = y[i2];
-        cvx[0][j] = vx[i0], cvx[1][j] = vx[i1], cvx[2][j] = vx[i2];
-        cvy[0][j] = vy[i0], cvy[1][j] = vy[i1], cvy[2][j] = vy[i2];
-      }
-      double en = 0.0, pw = 0.0, pp = 0.0;
-#pragma omp simd reduction(+ : en, pw, pp)
-      for (int j = 0; j < len; ++j) {  // compute
-        const Index e = c0 + j;
-        TriangleState s;
-        for (int a = 0; a < 3; ++a) {
-          s.x[a] = cx[a][j], s.y[a] = cy[a][j];
-          s.vx[a] = cvx[a][j], s.vy[a] = cvy[a][j];
-        }
-        const EdgeInverse b{b00[e], b01[e], b10[e], b11[e]};
-        const CstForce f = cst_force(s, b, area0[e] * thickness, law);
-        for (int a = 0; a < 3; ++a) cfx[a][j] = f.fx[a], cfy[a][j] = f.fy[a];
-        en += f.energy;
-        pw += f.damping_power;
-        if constexpr (kViscous) {
-          // Power of the previous step's viscous stress at the current velocities; then keep
-          // this step's.
-          double* __restrict pv = viscous + e;
-          pp += pv[0] * f.rate[0] + pv[nt] * f.rate[1] + pv[2 * nt] * f.rate[2] +
-                pv[3 * nt] * f.rate[3];
-          pv[0] = f.viscous[0], pv[nt] = f.viscous[1];
-          pv[2 * nt] = f.viscous[2], pv[3 * nt] = f.viscous[3];
-        }
-      }
-      energy += en, power += pw, previous_power += pp;
+      const ChunkSums c = chunk_forces<kViscous>(a, law, viscous, c0, len, cfx[0], cfy[0]);
+      sum.energy += c.energy, sum.power += c.power, sum.previous_power += c.previous_power;
       for (int j = 0; j < len; ++j) {  // scatter
-        const Index e = c0 + j, i0 = n0[e], i1 = n1[e], i2 = n2[e];
+        const Index e = c0 + j, i0 = a.n0[e], i1 = a.n1[e], i2 = a.n2[e];
         fx[i0] += cfx[0][j], fx[i1] += cfx[1][j], fx[i2] += cfx[2][j];
         fy[i0] += cfy[0][j], fy[i1] += cfy[1][j], fy[i2] += cfy[2][j];
       }
     }
   }
-  ElementStageResult out;
-  out.strain_energy = energy;
-  out.damping_power = power;
-  out.previous_damping_power = previous_power;
-  return out;
+  return result_of(sum);
+}
+
+// Chunk list and node -> corner-slot CSR of the threaded path (layout in cst.hpp).
+void build_workspace(const Model& model, ElementWorkspace& w) {
+  w.chunk_first.clear();
+  w.chunk_len.clear();
+  for (const Block& block : model.blocks) {
+    if (block.fixed) continue;
+    const Index end = block.first_tri + block.tri_count;
+    for (Index c0 = block.first_tri; c0 < end; c0 += kChunk) {
+      w.chunk_first.push_back(c0);
+      w.chunk_len.push_back(int(std::min<Index>(kChunk, end - c0)));
+    }
+  }
+  const std::size_t chunks = w.chunk_first.size(), slots = 3 * kChunk * chunks;
+  w.corner_fx.assign(slots, 0.0);
+  w.corner_fy.assign(slots, 0.0);
+  w.chunk_sums.assign(3 * chunks, 0.0);
+  const Index nn = model.nodes.size();
+  const Triangles& t = model.tris;
+  w.node_begin.assign(std::size_t(nn) + 1, 0);
+  for (std::size_t k = 0; k < chunks; ++k)
+    for (int j = 0; j < w.chunk_len[k]; ++j) {
+      const Index e = w.chunk_first[k] + j;
+      ++w.node_begin[t.n0[e] + 1], ++w.node_begin[t.n1[e] + 1], ++w.node_begin[t.n2[e] + 1];
+    }
+  for (Index i = 0; i < nn; ++i) w.node_begin[i + 1] += w.node_begin[i];
+  w.node_corner.assign(std::size_t(w.node_begin[nn]), 0);
+  std::vector<Index> fill(w.node_begin.begin(), w.node_begin.end() - 1);
+  for (std::size_t k = 0; k < chunks; ++k)  // ascending triangle order within each node
+    for (int j = 0; j < w.chunk_len[k]; ++j) {
+      const Index e = w.chunk_first[k] + j, slot = Index(k * 3 * kChunk) + j;
+      const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
+      for (int c = 0; c < 3; ++c) w.node_corner[fill[v[c]]++] = slot + c * kChunk;
+    }
+  w.built_tris = t.size();
+  w.built_nodes = nn;
+}
+
+// The threaded element stage: chunks on the threads, then the per-node gather.
+template <bool kViscous>
+ElementStageResult element_threads(Model& model, const CstLaw& law, double* viscous,
+                                   ElementWorkspace& w) {
+  const ElementArrays a = arrays_of(model);
+  double* __restrict fx = model.nodes.fx.data();
+  double* __restrict fy = model.nodes.fy.data();
+  const std::int64_t chunks = std::int64_t(w.chunk_first.size());
+  const Index nn = model.nodes.size();
+  double* corner_fx = w.corner_fx.data();
+  double* corner_fy = w.corner_fy.data();
+  double* sums = w.chunk_sums.data();
+  const Index* __restrict begin = w.node_begin.data();
+  const Index* __restrict corner = w.node_corner.data();
+#pragma omp parallel
+  {
+#pragma omp for schedule(static)
+    for (std::int64_t k = 0; k < chunks; ++k) {
+      const ChunkSums c =
+          chunk_forces<kViscous>(a, law, viscous, w.chunk_first[k], w.chunk_len[k],
+                                 corner_fx + k * 3 * kChunk, corner_fy + k * 3 * kChunk);
+      sums[3 * k] = c.energy, sums[3 * k + 1] = c.power, sums[3 * k + 2] = c.previous_power;
+    }
+#pragma omp for schedule(static)
+    for (Index i = 0; i < nn; ++i) {  // gather, in the scatter's order
+      double sx = fx[i], sy = fy[i];
+      for (Index s = begin[i]; s < begin[i + 1]; ++s) sx += corner_fx[corner[s]];
+      for (Index s = begin[i]; s < begin[i + 1]; ++s) sy += corner_fy[corner[s]];
+      fx[i] = sx, fy[i] = sy;
+    }
+  }
+  ChunkSums sum;
+  for (std::int64_t k = 0; k < chunks; ++k)
+    sum.energy += sums[3 * k], sum.power += sums[3 * k + 1], sum.previous_power += sums[3 * k + 2];
+  return result_of(sum);
 }
 
 }  // namespace
 
-ElementStageResult add_element_forces(Model& model, const CstLaw& law, double* viscous) {
-  if (viscous != nullptr && law.eta > 0.0) return element_loop<true>(model, law, viscous);
-  return element_loop<false>(model, law, nullptr);
+ElementStageResult add_element_forces(Model& model, const CstLaw& law, double* viscous,
+                                      ElementWorkspace* work) {
+  const bool damped = viscous != nullptr && law.eta > 0.0;
+  if (work != nullptr && model.tris.size() >= kParallelTriangles && threads_available()) {
+    if (work->built_tris != model.tris.size() || work->built_nodes != model.nodes.size())
+      build_workspace(model, *work);
+    if (std::int64_t(work->chunk_first.size()) * kChunk >= kParallelTriangles)
+      return damped ? element_threads<true>(model, law, viscous, *work)
+                    : element_threads<false>(model, law, nullptr, *work);
+  }
+  return damped ? element_loop<true>(model, law, viscous)
+                : element_loop<false>(model, law, nullptr);
 }
 
 CstFrequencyBound max_frequency_bound(const Model& model, const CstLaw& law) {

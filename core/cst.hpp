@@ -44,6 +44,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "core/model.hpp"
 
@@ -285,13 +286,40 @@ struct ElementStageResult {
   double previous_damping_power = 0.0;
 };
 
+// Triangles per chunk of the element loop (core/cst.cpp): the unit of vectorization and of the
+// work handed to threads.
+constexpr int kElementChunk = 32;
+
+// Scratch of the threaded element stage, built at its first use for a model and kept by the
+// Simulation (the triangle and node sets and the blocks' fixed flags must not change after).
+//   chunk_first[k], chunk_len[k]: triangles [first, first + len) of chunk k, in the order of
+//     the one-thread loop (free blocks in order, kElementChunk triangles at a time);
+//   corner_fx/fy[k * 3 kElementChunk + a kElementChunk + j]: force on corner a of triangle
+//     chunk_first[k] + j (the chunk buffer layout of the kernel);
+//   node_begin / node_corner (CSR, size nodes + 1 / corners of free triangles): the corner
+//     slots of node i, in ascending triangle order, i.e. the order in which the one-thread loop
+//     adds them into fx[i];
+//   chunk_sums[3 k ..]: energy, damping power, previous damping power of chunk k.
+struct ElementWorkspace {
+  std::vector<Index> chunk_first;
+  std::vector<int> chunk_len;
+  std::vector<double> corner_fx, corner_fy;
+  std::vector<Index> node_begin, node_corner;
+  std::vector<double> chunk_sums;
+  Index built_tris = -1, built_nodes = -1;
+};
+
 // Element stage: adds the CST forces of every triangle of a free block into nodes.fx/fy
 // (triangles of fixed blocks are skipped: their nodes never move).
 // `viscous` (4 x triangle count, component-major: viscous[k * ntri + e] is component k of
 // V0 P_v of triangle e, row-major k = 00, 01, 10, 11; or nullptr) holds the previous step's
 // viscous stress on entry and this step's on return; it feeds the exact damping work of the
 // ledger (ElementStageResult::previous_damping_power).
-ElementStageResult add_element_forces(Model& model, const CstLaw& law, double* viscous = nullptr);
+// With a workspace, at least kParallelTriangles free triangles, more than one OpenMP thread and
+// no enclosing parallel region, the stage runs on threads; the result is bit-identical to the
+// one-thread loop (core/cst.cpp explains why).
+ElementStageResult add_element_forces(Model& model, const CstLaw& law, double* viscous = nullptr,
+                                      ElementWorkspace* work = nullptr);
 
 // Largest element bounds over the triangles of free blocks (all blocks if none is free).
 CstFrequencyBound max_frequency_bound(const Model& model, const CstLaw& law);

@@ -20,10 +20,11 @@
 
 namespace voussoir {
 
-// Clears the force accumulators of every node.
+// Clears the force accumulators of every node (on the OpenMP threads for large models).
 void clear_forces(Nodes& nodes);
 
-// Velocity then position update of the nodes of free blocks; returns K^n above [J].
+// Velocity then position update of the nodes of free blocks; returns K^n above [J]. Threaded
+// above a size threshold, bit-identical for any thread count (integrate.cpp).
 double integrate_central_difference(Model& model, double dt);
 
 }  // namespace voussoir

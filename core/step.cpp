@@ -90,8 +90,8 @@ void advance(Simulation& sim) {
   } else {
     sim.viscous_piola.clear();
   }
-  const ElementStageResult el =
-      add_element_forces(model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr);
+  const ElementStageResult el = add_element_forces(
+      model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr, &sim.element_work);
   clock.stamp(timers.elements);
 
   // 4. contact forces (sets ledger.contact, accumulates friction dissipation)

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "contact/contact.hpp"
+#include "core/cst.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
 
@@ -51,6 +52,8 @@ struct Simulation {
   // add_element_forces) for the exact damping work of the ledger; sized by advance(), empty
   // when undamped.
   std::vector<double> viscous_piola;
+  // Scratch of the threaded element stage (core/cst.hpp), built at the first large step.
+  ElementWorkspace element_work;
 };
 
 // Fills ctx law constants and eta from the model material and damping factor.
