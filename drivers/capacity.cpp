@@ -10,6 +10,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 #include "limit/limit_analysis.hpp"
@@ -18,68 +19,6 @@ namespace voussoir {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-// Largest speed of any free node [m/s].
-double max_free_speed(const Nodes& n) {
-  double v2 = 0.0;
-  for (Index i = 0; i < n.size(); ++i)
-    if (n.inv_mass[i] != 0.0) v2 = std::max(v2, n.vx[i] * n.vx[i] + n.vy[i] * n.vy[i]);
-  return std::sqrt(v2);
-}
-
-double reference_length(const Model& model) {
-  double a = std::numeric_limits<double>::infinity();
-  for (const Block& b : model.blocks)
-    if (!b.fixed) a = std::min(a, b.area);
-  return std::isfinite(a) ? std::sqrt(a) : 1.0;
-}
-
-// Samples are taken every kSampleTime of simulated time: the criteria need no finer reading
-// and a sample costs a pass over the nodes.
-constexpr double kSampleTime = 1e-3;  // [s]
-
-// Hinge thresholds for reports: a joint is open when its gap exceeds 1% of L_ref, sliding
-// when its slip exceeds 1% of L_ref.
-constexpr double kHingeFraction = 0.01;
-
-// At rest: the largest free-node speed has stayed below v_rest for the hold window, and the
-// kinetic energy is not growing over it (its peak over the second half of the window is no
-// larger than over the first half). The second condition tells a decaying oscillation from a
-// mechanism that has just started to move and is still slow.
-class RestDetector {
- public:
-  RestDetector(double v_rest, double hold) : v_rest_(v_rest), hold_(hold) {}
-  bool update(double t, double v_max, double kinetic) {
-    if (v_max >= v_rest_) {
-      window_.clear();
-      return false;
-    }
-    window_.push_back({t, kinetic});
-    const double t0 = window_.front().t;
-    if (t - t0 < hold_) return false;
-    const double mid = t0 + 0.5 * (t - t0);
-    double first = 0.0, second = 0.0;
-    for (const Sample& s : window_) {
-      double& peak = s.t <= mid ? first : second;
-      peak = std::max(peak, s.kinetic);
-    }
-    if (second <= first) return true;
-    // Growing: keep watching the second half.
-    while (!window_.empty() && window_.front().t <= mid) window_.erase(window_.begin());
-    return false;
-  }
-
- private:
-  struct Sample {
-    double t, kinetic;
-  };
-  double v_rest_, hold_;
-  std::vector<Sample> window_;
-};
 
 }  // namespace
 

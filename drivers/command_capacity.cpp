@@ -1,5 +1,6 @@
 // `voussoir capacity DECK`: lambda* by k-section bisection, with every trial in the JSON.
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -17,7 +18,8 @@ nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
                    {"blocks", {h.block_a, h.block_b}},
                    {"kind", h.kind},
                    {"side", h.side},
-                   {"position_deg", h.position_deg},
+                   {"position_deg", std::isfinite(h.position_deg) ? nlohmann::json(h.position_deg)
+                                                                  : nlohmann::json(nullptr)},
                    {"x", h.x},
                    {"y", h.y},
                    {"opening", h.opening},
@@ -46,10 +48,13 @@ int command_capacity(const Config& config, const CommonOptions& common,
     std::printf("%d trials taken from the journal %s\n", res.resumed_trials, opts.resume.c_str());
   if (!res.bracketed)
     std::printf("no collapse found up to lambda = 8: lambda* is at least %.4f\n", res.lo);
-  for (const Hinge& h : res.hinges)
-    std::printf("  %-7s joint %d (blocks %d-%d) at %.1f deg%s%s\n", h.kind.c_str(), h.joint,
-                h.block_a, h.block_b, h.position_deg, h.side.empty() ? "" : ", pivot at ",
-                h.side.c_str());
+  for (const Hinge& h : res.hinges) {
+    std::printf("  %-7s joint %d (blocks %d-%d)", h.kind.c_str(), h.joint, h.block_a, h.block_b);
+    // Joints off the arch centreline (a buttress on its ground) have no angular position.
+    if (std::isfinite(h.position_deg)) std::printf(" at %.1f deg", h.position_deg);
+    if (!h.side.empty()) std::printf(", pivot at %s", h.side.c_str());
+    std::printf(" (%.4f, %.4f)\n", h.x, h.y);
+  }
 
   if ((!opts.mode_out.empty() || !opts.picture.empty()) && !res.has_mode)
     std::fprintf(stderr, "voussoir: no failure-mode picture: %s\n",

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/cst.hpp"
+#include "drivers/commands.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
@@ -25,21 +26,6 @@ namespace voussoir {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-nlohmann::json hinges_json(const std::vector<Hinge>& hinges) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const Hinge& h : hinges)
-    out.push_back({{"joint", h.joint},
-                   {"blocks", {h.block_a, h.block_b}},
-                   {"kind", h.kind},
-                   {"side", h.side},
-                   {"position_deg", h.position_deg},
-                   {"x", h.x},
-                   {"y", h.y},
-                   {"opening", h.opening},
-                   {"slip", h.slip}});
-  return out;
-}
 
 nlohmann::json control_json(const std::vector<ControlSummary>& control) {
   nlohmann::json out = nlohmann::json::object();
@@ -204,7 +190,7 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
                         {"max_energy_balance_error", r.max_energy_balance_error},
                         {"pulse_energy_balance_error", r.pulse_energy_balance_error},
                         {"peak_energy", r.peak_energy},
-                        {"hinges", hinges_json(r.hinges)},
+                        {"hinges", hinges_to_json(r.hinges)},
                         {"steps", r.steps},
                         {"dt", settled.sim.ctx.dt},
                         {"triangles", settled.sim.model.tris.size()},

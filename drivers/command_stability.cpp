@@ -11,6 +11,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "drivers/commands.hpp"
 #include "drivers/stability.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
@@ -24,22 +25,6 @@ nlohmann::json param_value(const std::string& s) {
   const double v = std::strtod(s.c_str(), &end);
   if (!s.empty() && end == s.c_str() + s.size() && std::isfinite(v)) return v;
   return s;
-}
-
-nlohmann::json hinges_json(const std::vector<Hinge>& hinges) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const Hinge& h : hinges)
-    out.push_back({{"joint", h.joint},
-                   {"blocks", {h.block_a, h.block_b}},
-                   {"kind", h.kind},
-                   {"side", h.side},
-                   {"position_deg", std::isfinite(h.position_deg) ? nlohmann::json(h.position_deg)
-                                                                  : nlohmann::json(nullptr)},
-                   {"x", h.x},
-                   {"y", h.y},
-                   {"opening", h.opening},
-                   {"slip", h.slip}});
-  return out;
 }
 
 nlohmann::json polygons_json(const std::vector<std::vector<Vec2>>& polys) {
@@ -130,7 +115,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
                         {"la_admissible", r.la_admissible},
                         {"la_status", r.la_status},
                         {"disagree", r.disagrees()},
-                        {"hinges", hinges_json(r.hinges)}};
+                        {"hinges", hinges_to_json(r.hinges)}};
     if (!r.error.empty()) j["error"] = r.error;
     jcells.push_back(j);
   }
@@ -163,7 +148,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
                   {"fixed", fixed},
                   {"reference", polygons_json(r.outlines0)},
                   {"deformed", polygons_json(r.outlines)},
-                  {"hinges", hinges_json(r.hinges)}},
+                  {"hinges", hinges_to_json(r.hinges)}},
                  (std::filesystem::path(opts.mode_out) / name).string());
     }
   }

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 
@@ -17,17 +18,6 @@ namespace voussoir {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-double max_free_speed(const Nodes& n) {
-  double v2 = 0.0;
-  for (Index i = 0; i < n.size(); ++i)
-    if (n.inv_mass[i] != 0.0) v2 = std::max(v2, n.vx[i] * n.vx[i] + n.vy[i] * n.vy[i]);
-  return std::sqrt(v2);
-}
 
 // Node of block b nearest to p.
 Index nearest_node(const Model& model, Index b, Vec2 p) {
@@ -41,9 +31,6 @@ Index nearest_node(const Model& model, Index b, Vec2 p) {
   }
   return best;
 }
-
-// Hinge thresholds for the report, as in capacity: 1% of L_ref.
-constexpr double kHingeFraction = 0.01;
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include <limits>
 #include <sstream>
 
+#include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
@@ -24,16 +25,6 @@ namespace voussoir {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-// Criteria are read every kSampleTime of simulated time (as in capacity trials).
-constexpr double kSampleTime = 1e-3;  // [s]
-
-// Hinge report thresholds: gap or slip above 1% of L_ref (as in capacity).
-constexpr double kHingeFraction = 0.01;
 
 // Whole text parsed as a finite number.
 bool parse_number(const std::string& s, double& v) {
@@ -70,57 +61,6 @@ std::string format_number(double v, int decimals) {
   }
   return s;
 }
-
-// Largest speed of any free node [m/s].
-double max_free_speed(const Nodes& n) {
-  double v2 = 0.0;
-  for (Index i = 0; i < n.size(); ++i)
-    if (n.inv_mass[i] != 0.0) v2 = std::max(v2, n.vx[i] * n.vx[i] + n.vy[i] * n.vy[i]);
-  return std::sqrt(v2);
-}
-
-// Square root of the smallest free block area [m] (capacity's L_ref).
-double reference_length(const Model& model) {
-  double a = std::numeric_limits<double>::infinity();
-  for (const Block& b : model.blocks)
-    if (!b.fixed) a = std::min(a, b.area);
-  return std::isfinite(a) ? std::sqrt(a) : 1.0;
-}
-
-// At rest (capacity's rule, drivers/capacity.cpp): the largest free-node speed has stayed
-// below v_rest for the hold window and the kinetic energy is not growing over it (its peak
-// over the second half of the window is no larger than over the first half), which tells a
-// decaying oscillation from a mechanism that has just started and is still slow.
-class RestDetector {
- public:
-  RestDetector(double v_rest, double hold) : v_rest_(v_rest), hold_(hold) {}
-  bool update(double t, double v_max, double kinetic) {
-    if (v_max >= v_rest_) {
-      window_.clear();
-      return false;
-    }
-    window_.push_back({t, kinetic});
-    const double t0 = window_.front().t;
-    if (t - t0 < hold_) return false;
-    const double mid = t0 + 0.5 * (t - t0);
-    double first = 0.0, second = 0.0;
-    for (const Sample& s : window_) {
-      double& peak = s.t <= mid ? first : second;
-      peak = std::max(peak, s.kinetic);
-    }
-    if (second <= first) return true;
-    // Growing: keep watching the second half.
-    while (!window_.empty() && window_.front().t <= mid) window_.erase(window_.begin());
-    return false;
-  }
-
- private:
-  struct Sample {
-    double t, kinetic;
-  };
-  double v_rest_, hold_;
-  std::vector<Sample> window_;
-};
 
 bool is_arch(const std::string& kind) {
   return kind == "circular_arch" || kind == "basket_arch" || kind == "buttressed_arch";

@@ -1,0 +1,79 @@
+#pragma once
+// Motion measures shared by the drivers that classify runs (capacity trials, pulses, the
+// stability map): free-node speed, the reference block size, the at-rest rule, and the
+// fractions and sampling period they use.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace voussoir {
+
+// Criteria are read every kSampleTime of simulated time: none needs a finer reading, and a
+// sample costs a pass over the nodes.
+constexpr double kSampleTime = 1e-3;  // [s]
+
+// Hinge thresholds for reports: a joint is open when its gap exceeds 1% of L_ref, sliding
+// when its slip exceeds 1% of L_ref.
+constexpr double kHingeFraction = 0.01;
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Largest speed of any free node [m/s].
+inline double max_free_speed(const Nodes& n) {
+  double v2 = 0.0;
+  for (Index i = 0; i < n.size(); ++i)
+    if (n.inv_mass[i] != 0.0) v2 = std::max(v2, n.vx[i] * n.vx[i] + n.vy[i] * n.vy[i]);
+  return std::sqrt(v2);
+}
+
+// L_ref: square root of the smallest free block area [m] (1 when no block is free).
+inline double reference_length(const Model& model) {
+  double a = std::numeric_limits<double>::infinity();
+  for (const Block& b : model.blocks)
+    if (!b.fixed) a = std::min(a, b.area);
+  return std::isfinite(a) ? std::sqrt(a) : 1.0;
+}
+
+// At rest: the largest free-node speed has stayed below v_rest for the hold window, and the
+// kinetic energy is not growing over it (its peak over the second half of the window is no
+// larger than over the first half). The second condition tells a decaying oscillation from a
+// mechanism that has just started to move and is still slow.
+class RestDetector {
+ public:
+  RestDetector(double v_rest, double hold) : v_rest_(v_rest), hold_(hold) {}
+  bool update(double t, double v_max, double kinetic) {
+    if (v_max >= v_rest_) {
+      window_.clear();
+      return false;
+    }
+    window_.push_back({t, kinetic});
+    const double t0 = window_.front().t;
+    if (t - t0 < hold_) return false;
+    const double mid = t0 + 0.5 * (t - t0);
+    double first = 0.0, second = 0.0;
+    for (const Sample& s : window_) {
+      double& peak = s.t <= mid ? first : second;
+      peak = std::max(peak, s.kinetic);
+    }
+    if (second <= first) return true;
+    // Growing: keep watching the second half.
+    while (!window_.empty() && window_.front().t <= mid) window_.erase(window_.begin());
+    return false;
+  }
+
+ private:
+  struct Sample {
+    double t, kinetic;
+  };
+  double v_rest_, hold_;
+  std::vector<Sample> window_;
+};
+
+}  // namespace voussoir
