@@ -157,71 +157,94 @@ inline void integrate_phi(const double* alpha, const double* beta, double& i0, d
   i1 = 0.5 * j1;
 }
 
-// int_Q f dA for f affine over a convex polygon Q (counter-clockwise): a fan of triangles from
-// Q's first vertex, each its area times the mean of f at its corners, f clamped at zero at
-// the vertices (it is a barycentric coordinate of a triangle containing Q; a clipped vertex
-// may lie a rounding error outside). Coordinates relative to the first vertex, so a thin Q
-// keeps its area to the rounding of its vertices.
-inline double integrate_affine(const Poly& Q, const Affine& f) {
-  if (Q.n < 3) return 0.0;
-  const double x0 = Q.x[0], y0 = Q.y[0];
-  const double f0 = std::max(0.0, f(x0, y0));
-  double f_prev = std::max(0.0, f(Q.x[1], Q.y[1]));
-  double sum = 0.0;  // sum of (twice the area) x (sum of the three corner values)
-  for (int k = 2; k < Q.n; ++k) {
-    const double fk = std::max(0.0, f(Q.x[k], Q.y[k]));
-    const double cr = (Q.x[k - 1] - x0) * (Q.y[k] - y0) - (Q.y[k - 1] - y0) * (Q.x[k] - x0);
-    sum += cr * (f0 + f_prev + fk);
-    f_prev = fk;
+// Phi_T = int_P phi_T dA by the divergence theorem about a reference point X. On the
+// sub-triangle R_k(T) phi = 3 lambda_k is affine, so div(phi (x - X)) = grad phi . (x - X) +
+// 2 phi = 3 phi - 3 lambda_k(X), and phi (x - X) is continuous across the sub-triangle lines:
+//     Phi = ( oint phi (x - X) . n ds + sum_k 3 lambda_k(X) |P n R_k| ) / 3.
+// R_m is the sub-triangle holding P's centroid. When P stays in R_m, X is the centroid
+// projected onto the line of edge m (lambda_m(X) = 0): no area term at all. When P reaches
+// into R_k too (a strip running into a corner of T), X is the vertex where edges m and k meet
+// (lambda_m = lambda_k = 0 there); only a third sub-triangle, if P reaches it as well, needs
+// its piece (P clipped to R_k, an area ~d^2 for a strip of depth d). Near edge m, phi and
+// (x - X) . n on P's boundary are both ~d and of one sign, so a thin overlap gets Phi to the
+// relative error of its vertices' distances to the edge, ~eps L / d
+// (tests/unit/test_narrow_phase.cpp, ThinStripEnergy*).
+// Replaced: X = G, the centroid of T, where every 3 lambda_k(G) = 1 and the terms sum to the
+// overlap area: Phi = (oint phi (x - G) . n ds + A_P) / 3 needs no clipping but subtracts two
+// quantities of the size of A_P; a strip 1e-12 m deep lost every digit of its energy and came
+// out negative (docs/robustness.md section 2). Tried: each piece P n R_m integrated as a fan
+// of 3 lambda_m (exact and stable, but six clips whenever P reaches a corner of T): 134 k
+// instructions per step of the resting 188-triangle arch against 114 k here and 101 k with
+// the unstable form (callgrind, steps 1000 to 2000).
+struct PhiReference {
+  double x = 0.0, y = 0.0;  // X (local coordinates)
+  double corners = 0.0;     // sum over k of 3 lambda_k(X) |P n R_k|
+};
+
+// (px, py): T's vertices; (cx, cy): P's centroid.
+inline PhiReference phi_reference(const Bary& T, const double* px, const double* py, const Poly& P,
+                                  double cx, double cy) {
+  const double l0 = T.lam[0](cx, cy), l1 = T.lam[1](cx, cy), l2 = T.lam[2](cx, cy);
+  const int m = l0 <= l1 ? (l0 <= l2 ? 0 : 2) : (l1 <= l2 ? 1 : 2);
+  const Affine& lm = T.lam[m];
+  // Which other sub-triangles P reaches into (P convex: none of R_k when lambda_k is not below
+  // lambda_m, or not below lambda_j, at any vertex of P).
+  const int k1 = (m + 1) % 3, k2 = (m + 2) % 3;
+  bool k1_above_m = true, k1_above_k2 = true, k2_above_m = true, k2_above_k1 = true;
+  for (int v = 0; v < P.n; ++v) {
+    const double am = lm(P.x[v], P.y[v]), a1 = T.lam[k1](P.x[v], P.y[v]),
+                 a2 = T.lam[k2](P.x[v], P.y[v]);
+    k1_above_m = k1_above_m && a1 >= am;
+    k1_above_k2 = k1_above_k2 && a1 >= a2;
+    k2_above_m = k2_above_m && a2 >= am;
+    k2_above_k1 = k2_above_k1 && a2 >= a1;
   }
-  return sum * (1.0 / 6.0);
+  bool reaches[3] = {false, false, false};
+  reaches[k1] = !(k1_above_m || k1_above_k2);
+  reaches[k2] = !(k2_above_m || k2_above_k1);
+  PhiReference r;
+  int skip = m;  // the corner term that vanishes at X besides m's
+  if (reaches[k1] || reaches[k2]) {
+    // P reaches a corner of T: X = the vertex where edge m meets the edge of a sub-triangle P
+    // reaches (lambda_m = lambda_k = 0 there), so only a third sub-triangle needs its piece.
+    const int k = reaches[k1] ? k1 : k2;
+    const int v = 3 - m - k;  // the vertex opposite the third edge: on edges m and k
+    r.x = px[v];
+    r.y = py[v];
+    skip = k;
+  } else {
+    // Within R_m: X = the centroid projected onto edge line m (lambda_m(X) = 0).
+    const double s = (m == 0 ? l0 : (m == 1 ? l1 : l2)) / (lm.b * lm.b + lm.c * lm.c);
+    r.x = cx - s * lm.b;
+    r.y = cy - s * lm.c;
+    return r;
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (k == m || k == skip || !reaches[k]) continue;
+    const Affine& lk = T.lam[k];
+    const Affine& lj = T.lam[3 - m - k];
+    Poly half, piece;
+    clip(P, {lm.a - lk.a, lm.b - lk.b, lm.c - lk.c}, half);  // lambda_m >= lambda_k
+    clip(half, {lj.a - lk.a, lj.b - lk.b, lj.c - lk.c}, piece);
+    r.corners += 3.0 * lk(r.x, r.y) * moments(piece).area;
+  }
+  return r;
 }
 
-// Phi_T = int_P phi_T dA, piece by piece: on P n R_m(T) phi_T = 3 lambda_m is affine, so its
-// integral is exact from the piece's vertex values, and lambda_m is evaluated directly
-// (a scaled distance to edge m: small where the overlap is thin, never "1 - something").
-// The relative error is that of the clipped vertices' distances to the edges, ~eps L / d for
-// a strip of depth d and length L (tests/unit/test_narrow_phase.cpp, ThinStripEnergy*).
-// Usually P lies in one sub-triangle (all its vertices have the same smallest coordinate; P
-// and R_m are convex, so then P is inside R_m) and one fan does it; otherwise P is clipped
-// to each R_m = {lambda_i >= lambda_m, lambda_j >= lambda_m}.
-// Rejected: Phi = (oint phi (x - G) . n ds + A_P) / 3 (one boundary pass with the other
-// integrals) subtracts two quantities of the size of A_P; at rest (d ~ 1e-11 L) it lost every
-// digit and even turned negative (docs/robustness.md section 2).
-inline double potential_integral(const Bary& T, const Poly& P) {
-  auto argmin = [&](int v) {
-    const double l0 = T.lam[0](P.x[v], P.y[v]), l1 = T.lam[1](P.x[v], P.y[v]),
-                 l2 = T.lam[2](P.x[v], P.y[v]);
-    return l0 <= l1 ? (l0 <= l2 ? 0 : 2) : (l1 <= l2 ? 1 : 2);
-  };
-  const int m0 = argmin(0);
-  bool one_piece = true;
-  for (int v = 1; v < P.n && one_piece; ++v) one_piece = argmin(v) == m0;
-  if (one_piece) return 3.0 * integrate_affine(P, T.lam[m0]);
-  double phi = 0.0;
-  Poly half, piece;
-  for (int m = 0; m < 3; ++m) {
-    const Affine& lm = T.lam[m];
-    const Affine& li = T.lam[(m + 1) % 3];
-    const Affine& lj = T.lam[(m + 2) % 3];
-    clip(P, {li.a - lm.a, li.b - lm.b, li.c - lm.c}, half);
-    if (half.n < 3) continue;
-    clip(half, {lj.a - lm.a, lj.b - lm.b, lj.c - lm.c}, piece);
-    phi += 3.0 * integrate_affine(piece, lm);
-  }
-  return phi;
-}
-
-// Field of triangle T (barycentric lam) over P, by boundary integrals, given Phi_T.
+// Field of triangle T (barycentric lam, vertices px, py) over P, by boundary integrals;
+// (cx, cy) P's centroid.
 // phi_T vanishes on T's edges, so only the edges of P lying on the other triangle count
 // (on_c == other_is_c). With n ds = (dy, -dx) ds_param on a counter-clockwise polygon:
 //     int_P grad phi dA     = sum (dy, -dx) I0,
 //     int_P x grad phi dA   = sum (dy, -dx) Ix - (Phi, 0),   (integration by parts)
-//     int_P y grad phi dA   = sum (dy, -dx) Iy - (0, Phi).
-inline Field field_over(const Bary& T, const Poly& P, unsigned char other_is_c) {
+//     int_P y grad phi dA   = sum (dy, -dx) Iy - (0, Phi),
+//     Phi = int_P phi dA    = (sum (dy, -dx) . (Ix - X_x I0, Iy - X_y I0) + corners) / 3
+// (phi_reference above).
+inline Field field_over(const Bary& T, const double* px, const double* py, const Poly& P, double cx,
+                        double cy, unsigned char other_is_c) {
   Field f;
-  f.phi = potential_integral(T, P);
-  double j0x = 0.0, j0y = 0.0, jxx = 0.0, jxy = 0.0, jyx = 0.0, jyy = 0.0;
+  const PhiReference ref = phi_reference(T, px, py, P, cx, cy);
+  double j0x = 0.0, j0y = 0.0, jxx = 0.0, jxy = 0.0, jyx = 0.0, jyy = 0.0, k = 0.0;
   for (int q = 0, r = 1; q < P.n; ++q, r = (r + 1 == P.n ? 0 : r + 1)) {
     if (P.on_c[q] != other_is_c) continue;
     const double ax = P.x[q], ay = P.y[q], dx = P.x[r] - ax, dy = P.y[r] - ay;
@@ -240,7 +263,9 @@ inline Field field_over(const Bary& T, const Poly& P, unsigned char other_is_c) 
     jxy -= dx * ix;
     jyx += dy * iy;
     jyy -= dx * iy;
+    k += dy * ((ax - ref.x) * i0 + dx * i1) - dx * ((ay - ref.y) * i0 + dy * i1);
   }
+  f.phi = (k + ref.corners) * (1.0 / 3.0);
   f.g[0][0] = j0x;
   f.g[1][0] = j0y;
   f.g[0][1] = jxx - f.phi;
@@ -288,8 +313,9 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   PairForce out;
   const Edges et = edge_functions(tx, ty);
   const Bary bc = barycentric(ec), bt = barycentric(et);
-  const Field fc = field_over(bc, P, 0);
-  const Field ft = field_over(bt, P, 1);
+  const double c0x = mp.sx / mp.area, c0y = mp.sy / mp.area;  // overlap centroid
+  const Field fc = field_over(bc, cx, cy, P, c0x, c0y, 0);
+  const Field ft = field_over(bt, tx, ty, P, c0x, c0y, 1);
 
   // Nodal forces: f_i(c) = Ep [(G_c - G_t) l_i^c - Phi_t grad N_i^c], and symmetrically.
   double d[2][3];
@@ -309,7 +335,6 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   out.energy = phi_c + phi_t;
 
   // Point of action: on the line of action, nearest the overlap centroid (local coordinates).
-  const double c0x = mp.sx / mp.area, c0y = mp.sy / mp.area;
   out.centroid = {c0x + ox, c0y + oy};
   const double fx = d[0][0], fy = d[1][0];
   const double moment = d[1][1] - d[0][2];  // Ep int (x d_y phi - y d_x phi), c minus t

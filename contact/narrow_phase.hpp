@@ -39,19 +39,17 @@
 //     int_P grad phi dA     = oint phi n ds,
 //     int_P x grad phi dA   = oint x phi n ds - (Phi, 0),     (integration by parts)
 //     int_P y grad phi dA   = oint y phi n ds - (0, Phi),
-// with Phi = int_P phi dA itself summed over the pieces P n R_m(T) (at most three, usually
-// one), where phi = 3 lambda_m is affine: a fan of triangles per piece, each its area times
-// the mean of 3 lambda_m at its corners, lambda_m evaluated directly (a scaled distance to
-// edge m, small where the overlap is thin). phi_T vanishes on T's own edges, so in the
-// boundary integrals only the edges of P lying on t count for the field of c, and
-// conversely: one or two segments for a typical contact. Along a segment phi_T = 3 min_m lambda_m
-// is the lower envelope of three lines (concave, at most three pieces), integrated exactly piece by
-// piece (trapezoid and Simpson weights, no quadrature error). This is the edge-wise integration of
-// Munjiza's book carried to the nodal forces: the same boundary integrals give the resultant (his)
-// and the shape-function moments that make the forces the gradient of E (ours). Coordinates are
-// shifted to a local origin (c's first vertex) and P's area and moments are summed as a fan from
-// its own first vertex: overlaps at rest are ~1e-10 m deep and absolute coordinates would cancel
-// catastrophically.
+// with Phi = int_P phi dA itself from the divergence theorem about a point X on an edge line
+// of the triangle (narrow_phase.cpp, phi_reference: no cancellation at thin overlaps).
+// phi_T vanishes on T's own edges, so in the boundary integrals only the edges of P lying on
+// t count for the field of c, and conversely: one or two segments for a typical contact.
+// Along a segment phi_T = 3 min_m lambda_m is the lower envelope of three lines (concave, at
+// most three pieces), integrated exactly piece by piece (trapezoid and Simpson weights, no
+// quadrature error). This is the edge-wise integration of Munjiza's book carried to the nodal
+// forces: the same boundary integrals give the resultant (his) and the shape-function moments
+// that make the forces the gradient of E (ours). Coordinates are shifted to a local origin
+// (c's first vertex) and P's area and moments are summed as a fan from its own first vertex:
+// overlaps at rest are ~1e-10 m deep and absolute coordinates would cancel catastrophically.
 //
 // Point of action. The forces on c have resultant F and moment M = sum (x F_y - y F_x) about
 // the origin (the area-change term contributes neither); their line of action is
@@ -61,10 +59,11 @@
 // Tried and replaced (same forces to round-off, measured with callgrind on one strip-shaped
 // overlap): splitting P into the three sub-triangle regions by clipping for every integral
 // (~3000 instructions per pair) and a fan of signed triangles from G cut at the sub-triangle
-// lines (~3150); the edge-wise form takes ~2060. Its Phi was once the boundary integral
-// (oint phi (x - G) . n ds + A_P) / 3 (div(phi (x - G)) = 3 phi - 1 on every sub-triangle),
-// which subtracts two quantities of the size of the overlap area: for a resting strip ~1e-12
-// m deep it lost every digit of the energy (negative values; docs/robustness.md section 2).
+// lines (~3150); the edge-wise form takes ~2060. Its Phi was first
+// (oint phi (x - G) . n ds + A_P) / 3 with G the centroid of the triangle, which subtracts two
+// quantities of the size of the overlap area: for a resting strip ~1e-12 m deep it lost every
+// digit of the energy (negative values; docs/robustness.md section 2). X on an edge line
+// instead costs 5 to 18% more per strip-shaped overlap (callgrind).
 //
 // Negligible overlaps. An overlap smaller than kMinOverlapFraction of the smaller triangle's
 // area counts as no contact (no force, no energy, friction history reset). Such overlaps are
