@@ -63,8 +63,9 @@ struct ChunkSums {
 
 // Forces on the corners of triangles [c0, c0 + len) into cfx/cfy (layout [corner][j]) and
 // the chunk's energy sums; kViscous: read and update the viscous Piola buffer (ledger).
-// Not inlined, so that both paths run the very same code (same in-chunk summation order).
-template <bool kViscous>
+// kDamped: evaluate the viscous term (law.eta > 0). Not inlined, so that both paths run the
+// very same code (same in-chunk summation order).
+template <bool kViscous, bool kDamped>
 [[gnu::noinline]] ChunkSums chunk_forces(const ElementArrays& a, const CstLaw& law,
                                          double* __restrict viscous, Index c0, int len,
                                          double* __restrict cfx, double* __restrict cfy) {
@@ -101,10 +102,10 @@ template <bool kViscous>
       s.vx[c] = cvx[c][j], s.vy[c] = cvy[c][j];
     }
     const EdgeInverse b{b00[e], b01[e], b10[e], b11[e]};
-    const CstForce f = cst_force(s, b, area0[e] * thickness, law);
+    const CstForce f = cst_force<kDamped>(s, b, area0[e] * thickness, law);
     for (int c = 0; c < 3; ++c) cfx[c * kChunk + j] = f.fx[c], cfy[c * kChunk + j] = f.fy[c];
     en += f.energy;
-    pw += f.damping_power;
+    if constexpr (kDamped) pw += f.damping_power;
     if constexpr (kViscous) {
       // Power of the previous step's viscous stress at the current velocities; then keep
       // this step's.
@@ -127,7 +128,7 @@ ElementStageResult result_of(const ChunkSums& s) {
 }
 
 // The one-thread element loop: chunks of the free blocks in order, scatter after each.
-template <bool kViscous>
+template <bool kViscous, bool kDamped>
 ElementStageResult element_loop(Model& model, const CstLaw& law, double* viscous) {
   const ElementArrays a = arrays_of(model);
   double* __restrict fx = model.nodes.fx.data();
@@ -140,7 +141,7 @@ ElementStageResult element_loop(Model& model, const CstLaw& law, double* viscous
     const Index end = block.first_tri + block.tri_count;
     for (Index c0 = block.first_tri; c0 < end; c0 += kChunk) {
       const int len = int(std::min<Index>(kChunk, end - c0));
-      const ChunkSums c = chunk_forces<kViscous>(a, law, viscous, c0, len, cfx[0], cfy[0]);
+      const ChunkSums c = chunk_forces<kViscous, kDamped>(a, law, viscous, c0, len, cfx[0], cfy[0]);
       sum.energy += c.energy, sum.power += c.power, sum.previous_power += c.previous_power;
       for (int j = 0; j < len; ++j) {  // scatter
         const Index e = c0 + j, i0 = a.n0[e], i1 = a.n1[e], i2 = a.n2[e];
@@ -190,7 +191,7 @@ void build_workspace(const Model& model, ElementWorkspace& w) {
 }
 
 // The threaded element stage: chunks on the threads, then the per-node gather.
-template <bool kViscous>
+template <bool kViscous, bool kDamped>
 ElementStageResult element_threads(Model& model, const CstLaw& law, double* viscous,
                                    ElementWorkspace& w) {
   const ElementArrays a = arrays_of(model);
@@ -208,8 +209,8 @@ ElementStageResult element_threads(Model& model, const CstLaw& law, double* visc
 #pragma omp for schedule(static)
     for (std::int64_t k = 0; k < chunks; ++k) {
       const ChunkSums c =
-          chunk_forces<kViscous>(a, law, viscous, w.chunk_first[k], w.chunk_len[k],
-                                 corner_fx + k * 3 * kChunk, corner_fy + k * 3 * kChunk);
+          chunk_forces<kViscous, kDamped>(a, law, viscous, w.chunk_first[k], w.chunk_len[k],
+                                          corner_fx + k * 3 * kChunk, corner_fy + k * 3 * kChunk);
       sums[3 * k] = c.energy, sums[3 * k + 1] = c.power, sums[3 * k + 2] = c.previous_power;
     }
 #pragma omp for schedule(static)
@@ -226,20 +227,27 @@ ElementStageResult element_threads(Model& model, const CstLaw& law, double* visc
   return result_of(sum);
 }
 
-}  // namespace
-
-ElementStageResult add_element_forces(Model& model, const CstLaw& law, double* viscous,
-                                      ElementWorkspace* work) {
-  const bool damped = viscous != nullptr && law.eta > 0.0;
+// Specialised on the features in use: viscous term (eta > 0) and ledger buffer, so an
+// undamped run pays for neither (docs/benchmarks.md "Specialisation").
+template <bool kViscous, bool kDamped>
+ElementStageResult element_stage(Model& model, const CstLaw& law, double* viscous,
+                                 ElementWorkspace* work) {
   if (work != nullptr && model.tris.size() >= kParallelTriangles && threads_available()) {
     if (work->built_tris != model.tris.size() || work->built_nodes != model.nodes.size())
       build_workspace(model, *work);
     if (std::int64_t(work->chunk_first.size()) * kChunk >= kParallelTriangles)
-      return damped ? element_threads<true>(model, law, viscous, *work)
-                    : element_threads<false>(model, law, nullptr, *work);
+      return element_threads<kViscous, kDamped>(model, law, viscous, *work);
   }
-  return damped ? element_loop<true>(model, law, viscous)
-                : element_loop<false>(model, law, nullptr);
+  return element_loop<kViscous, kDamped>(model, law, viscous);
+}
+
+}  // namespace
+
+ElementStageResult add_element_forces(Model& model, const CstLaw& law, double* viscous,
+                                      ElementWorkspace* work) {
+  if (!(law.eta > 0.0)) return element_stage<false, false>(model, law, nullptr, work);
+  if (viscous == nullptr) return element_stage<false, true>(model, law, nullptr, work);
+  return element_stage<true, true>(model, law, viscous, work);
 }
 
 CstFrequencyBound max_frequency_bound(const Model& model, const CstLaw& law) {

@@ -72,12 +72,14 @@ struct TriangleState {
 // power V0 J eta D:D [W] (what the viscous term dissipates at this instant), and for the
 // energy ledger the viscous Piola stress times the volume, V0 P_v [N m], and Fdot [1/s]
 // (row-major), so that V0 P_v : Fdot' is the power of these viscous forces at other velocities.
+// No default initialisers: cst_force sets every field, and zero initialisers would become
+// block stores that stop the element loop from vectorizing (g++ 12, undamped variant).
 struct CstForce {
-  double fx[3] = {0.0, 0.0, 0.0}, fy[3] = {0.0, 0.0, 0.0};
-  double energy = 0.0;
-  double damping_power = 0.0;
-  double viscous[4] = {0.0, 0.0, 0.0, 0.0};
-  double rate[4] = {0.0, 0.0, 0.0, 0.0};
+  double fx[3], fy[3];
+  double energy;
+  double damping_power;
+  double viscous[4];
+  double rate[4];
 };
 
 // Symmetric 2D stress [Pa].
@@ -110,6 +112,9 @@ inline CstKinematics cst_kinematics(const TriangleState& s, const EdgeInverse& b
 
 // Internal forces, strain energy and damping power of one triangle of reference volume
 // `volume0` (area0 x out-of-plane thickness) [m3]. Pure; see the derivation at the top.
+// kDamped = false leaves out the viscous term (for law.eta = 0 it only adds zeros: the result
+// is the same up to the sign of zero forces); the element stage uses it for undamped runs.
+template <bool kDamped = true>
 inline CstForce cst_force(const TriangleState& s, const EdgeInverse& b, double volume0,
                           const CstLaw& law) {
   const CstKinematics k = cst_kinematics(s, b);
@@ -138,7 +143,7 @@ inline CstForce cst_force(const TriangleState& s, const EdgeInverse& b, double v
   // and the term has no branch (eta = 0 just gives zeros) so the element stage vectorizes
   // across triangles. A degenerate or inverted triangle (J <= 0) gets no damping rather than
   // a division by 0.
-  {
+  if constexpr (kDamped) {
     const double J = k.f00 * k.f11 - k.f01 * k.f10;
     const double j_pos = J > 0.0 ? J : std::numeric_limits<double>::infinity();
     const double sc = law.eta / j_pos;  // 0 when J <= 0 (branch-free)
@@ -155,6 +160,9 @@ inline CstForce cst_force(const TriangleState& s, const EdgeInverse& b, double v
     out.damping_power = volume0 * sc * (m00 * m00 + m11 * m11 + 2.0 * m01 * m01);
     out.viscous[0] = volume0 * v00, out.viscous[1] = volume0 * v01;
     out.viscous[2] = volume0 * v10, out.viscous[3] = volume0 * v11;
+  } else {
+    out.damping_power = 0.0;
+    out.viscous[0] = out.viscous[1] = out.viscous[2] = out.viscous[3] = 0.0;
   }
   out.rate[0] = k.d00, out.rate[1] = k.d01, out.rate[2] = k.d10, out.rate[3] = k.d11;
 
