@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "bench/wall.hpp"
 #include "core/cst.hpp"
 #include "core/integrate.hpp"
 #include "core/step.hpp"
@@ -23,24 +24,7 @@ using namespace voussoir;
 // nx x ny cells of 0.01 m, two triangles each.
 Simulation make_rectangle_sim(int nx, int ny, double damping_factor) {
   Simulation sim;
-  std::vector<Vec2> points;
-  const double h = 0.01;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) points.push_back({h * i, h * j});
-  auto id = [nx](int i, int j) { return Index(j * (nx + 1) + i); };
-  std::vector<std::array<Index, 3>> tris;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      if ((i + j) % 2 == 0) {
-        tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      } else {
-        tris.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
-        tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-    }
-  const std::vector<Vec2> outline = {{0, 0}, {h * nx, 0}, {h * nx, h * ny}, {0, h * ny}};
-  add_block(sim.model, outline, points, tris, false, "bench");
+  bench::add_grid_block(sim.model, 0.0, 0.0, 0.01 * nx, 0.01 * ny, nx, ny, false, "bench");
   finalize_model(sim.model);
   sim.ctx.contact_on = false;
   sim.ctx.body_ax = 0.0;

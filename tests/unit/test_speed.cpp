@@ -1,4 +1,5 @@
-// Speed-pass checks that could fail: the separating-axis pre-test the contact stage runs before
+// Speed-pass checks that could fail: the METIS locality ordering (core/ordering.hpp) must
+// change nothing but the numbering; the separating-axis pre-test the contact stage runs before
 // the narrow-phase kernel (contact/narrow_phase.hpp triangles_separated) may only reject pairs
 // whose kernel result is zero, and it must actually reject the pairs that are apart.
 #include <gtest/gtest.h>
@@ -7,7 +8,10 @@
 #include <cmath>
 #include <random>
 
+#include "bench/wall.hpp"
 #include "contact/narrow_phase.hpp"
+#include "core/cst.hpp"
+#include "core/ordering.hpp"
 
 using namespace voussoir;
 
@@ -68,4 +72,47 @@ TEST(Speed, SeparatingAxisOnSharedEdgeAndVertex) {
   EXPECT_TRUE(triangles_separated(c, shared_vertex));
   EXPECT_FALSE(triangles_separated(c, overlapping));
   EXPECT_GT(triangle_pair_force(c, overlapping, 1e9).area, 0.0);
+}
+
+// order_for_locality renumbers nodes and triangles inside blocks and nothing else: block
+// ranges, masses, areas, orientation and boundary edges are kept, and the element stage gives
+// the same strain energy for the same deformation (to round-off: the summation order changes).
+TEST(Speed, LocalityOrderingOnlyRenumbers) {
+  Model m;
+  bench::add_grid_block(m, 0.0, 0.0, 0.6, 0.4, 30, 20, false, "big");      // 651 nodes: ordered
+  bench::add_grid_block(m, 0.0, -0.1, 0.6, 0.1, 6, 1, true, "ground");     // 14 nodes: kept
+  finalize_model(m);
+  Model o = m;
+  order_for_locality(o);
+  ASSERT_EQ(o.nodes.size(), m.nodes.size());
+  ASSERT_EQ(o.tris.size(), m.tris.size());
+  bool moved = false;
+  for (Index i = 0; i < m.nodes.size(); ++i) moved = moved || o.nodes.x0[i] != m.nodes.x0[i];
+  EXPECT_TRUE(moved);
+  auto boundary_edges = [](const Model& x) {
+    int n = 0;
+    for (const std::uint8_t b : x.tris.boundary) n += (b & 1) + ((b >> 1) & 1) + ((b >> 2) & 1);
+    return n;
+  };
+  EXPECT_EQ(boundary_edges(o), boundary_edges(m));
+  for (std::size_t b = 0; b < m.blocks.size(); ++b) {
+    EXPECT_EQ(o.blocks[b].first_node, m.blocks[b].first_node);
+    EXPECT_EQ(o.blocks[b].first_tri, m.blocks[b].first_tri);
+    EXPECT_NEAR(o.blocks[b].mass, m.blocks[b].mass, 1e-12 * m.blocks[b].mass);
+    for (Index i = m.blocks[b].first_node; i < m.blocks[b].first_node + m.blocks[b].node_count; ++i)
+      EXPECT_EQ(o.nodes.block[i], Index(b));
+  }
+  for (Index e = 0; e < o.tris.size(); ++e) EXPECT_GT(o.tris.area0[e], 0.0);
+  // Same smooth deformation on both numberings.
+  for (Model* x : {&m, &o})
+    for (Index i = 0; i < x->nodes.size(); ++i) {
+      const double X = x->nodes.x0[i], Y = x->nodes.y0[i];
+      x->nodes.x[i] = X + 1e-4 * X * Y;
+      x->nodes.y[i] = Y - 2e-4 * X * X;
+    }
+  const CstLaw law{10e9, 15e9, 0.0};
+  const double um = add_element_forces(m, law).strain_energy;
+  const double uo = add_element_forces(o, law).strain_energy;
+  EXPECT_GT(um, 0.0);
+  EXPECT_NEAR(uo, um, 1e-12 * um);
 }
