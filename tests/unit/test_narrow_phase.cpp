@@ -338,6 +338,9 @@ TEST(NarrowPhase, ThinStripEnergyOfTheStiffArch) {
   // And the same with the roles swapped (the kernel is symmetric).
   const PairForce g = triangle_pair_force(t, c, Ep);
   EXPECT_NEAR(g.energy, ref, strip_tolerance(2.9e-12, 0.2) * ref);
+  std::printf("[thin strip] stiff arch pair: energy %.6e J (swapped %.6e J), reference %.6e J, "
+              "area %.4e m2, resultant (%.6e, %.6e) N\n",
+              f.energy, g.energy, ref, f.area, f.resultant.x, f.resultant.y);
 }
 
 // Strips of depth 1e-3 to 1e-13 of the element size L between a contactor face and a target
