@@ -7,8 +7,9 @@
 // Prints, per run: threads, wall s, process CPU s, triangle-steps per wall second, the stage
 // times (wall) and the load average before and after; runs alternate 1, 2, 1, 2 threads from
 // copies of the same settled state, and the final states are compared bit for bit.
-// Memory: VmRSS (/proc/self/status) before building, after building and after the first
-// steps (contact pairs and element workspace allocated), divided by the triangle count.
+// Memory: VmRSS (/proc/self/status) before building, after building and after 100 steps on
+// two threads (contact pairs and the threaded element workspace allocated), divided by the
+// triangle count. Use OMP_WAIT_POLICY=passive on a shared machine (docs/benchmarks.md).
 
 #include <omp.h>
 
@@ -60,14 +61,16 @@ int main(int argc, char** argv) {
   const double rss0 = vm_rss_kib();
   Simulation settled = bench::wall_simulation(courses, per_course, cells_x, cells_y);
   const double rss1 = vm_rss_kib();
-  for (int k = 0; k < 100; ++k) advance(settled);  // joints close; workspaces allocated
+  omp_set_num_threads(2);  // so that the threaded element workspace is allocated (and counted)
+  for (int k = 0; k < 100; ++k) advance(settled);  // joints close; contact pairs allocated
   const double rss2 = vm_rss_kib();
   const double tris = double(settled.model.tris.size());
   std::printf("wall %d x %d blocks of %d x %d cells: %.0f triangles, %d nodes, %zu candidate "
               "pairs, dt %.3e s\n",
               courses, per_course, cells_x, cells_y, tris, settled.model.nodes.size(),
               settled.contact.candidate_pairs(), settled.ctx.dt);
-  std::printf("memory: model %.0f B/triangle, model + step state (contact, workspace) %.0f "
+  std::printf("memory: model + contact setup %.0f B/triangle, + step state (pairs, viscous buffer, "
+              "element workspace) %.0f "
               "B/triangle (VmRSS %.0f -> %.0f -> %.0f KiB)\n",
               1024.0 * (rss1 - rss0) / tris, 1024.0 * (rss2 - rss0) / tris, rss0, rss1, rss2);
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <limits>
-#include <map>
 #include <utility>
 
 namespace voussoir {
@@ -54,6 +54,10 @@ void finalize_model(Model& model) {
   Nodes& n = model.nodes;
   Triangles& t = model.tris;
   const Index nt = t.size();
+  // add_block grows the arrays by push_back (capacity up to twice the size): trim once.
+  for (auto* v : {&n.x, &n.y, &n.vx, &n.vy, &n.fx, &n.fy, &n.inv_mass, &n.x0, &n.y0, &n.mass})
+    v->shrink_to_fit();
+  for (auto* v : {&n.block, &t.n0, &t.n1, &t.n2, &t.block}) v->shrink_to_fit();
   t.b00.assign(nt, 0.0);
   t.b01.assign(nt, 0.0);
   t.b10.assign(nt, 0.0);
@@ -81,18 +85,31 @@ void finalize_model(Model& model) {
     n.mass[i2] += m3;
   }
 
-  // An edge is on the block boundary when no other triangle of the same block shares it.
-  std::map<std::pair<Index, Index>, int> edge_count;
-  auto key = [](Index a, Index b) { return a < b ? std::make_pair(a, b) : std::make_pair(b, a); };
+  // An edge is on the block boundary when no other triangle shares it (nodes belong to one
+  // block, so a sharing triangle is of the same block). Sorted edge keys rather than a
+  // std::map: a map node per edge (~64 B x 1.5 edges per triangle) stayed in the resident
+  // set after being freed (docs/benchmarks.md "Memory per triangle").
+  auto key = [](Index a, Index b) {
+    const auto lo = std::uint64_t(std::uint32_t(std::min(a, b)));
+    const auto hi = std::uint64_t(std::uint32_t(std::max(a, b)));
+    return (lo << 32) | hi;
+  };
+  std::vector<std::uint64_t> edges;
+  edges.reserve(3 * std::size_t(nt));
   for (Index e = 0; e < nt; ++e) {
     const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
-    for (int k = 0; k < 3; ++k) ++edge_count[key(v[k], v[(k + 1) % 3])];
+    for (int k = 0; k < 3; ++k) edges.push_back(key(v[k], v[(k + 1) % 3]));
   }
+  std::sort(edges.begin(), edges.end());
+  auto shared = [&edges](std::uint64_t k) {
+    const auto it = std::lower_bound(edges.begin(), edges.end(), k);
+    return it + 1 != edges.end() && *(it + 1) == k;
+  };
   for (Index e = 0; e < nt; ++e) {
     const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
     std::uint8_t mask = 0;
     for (int k = 0; k < 3; ++k)
-      if (edge_count[key(v[k], v[(k + 1) % 3])] == 1) mask |= std::uint8_t(1u << k);
+      if (!shared(key(v[k], v[(k + 1) % 3]))) mask |= std::uint8_t(1u << k);
     t.boundary[e] = mask;
   }
 
