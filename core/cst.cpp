@@ -17,7 +17,8 @@ Stress2 triangle_cauchy_stress(const Model& model, Index e, const CstLaw& law) {
 
 namespace {
 
-// Threads. The one-thread loop runs over chunks of kElementChunk triangles: gather node data
+// Threads. The one-thread loop runs over chunks of kElementChunk triangles (of the runs of
+// contiguous free blocks, for_each_chunk): gather node data
 // into small local arrays, run the kernel over the chunk (no indirect writes, so it
 // vectorizes: 4 triangles per AVX2 op), then scatter the forces into fx, fy. Measured ~1.5x
 // over the plain gather-compute-scatter loop (damped, 1e5 triangles); 16, 32 and 64 perform
@@ -119,6 +120,25 @@ template <bool kViscous, bool kDamped>
   return ChunkSums{en, pw, pp};
 }
 
+// Calls f(c0, len) for the chunks of the element loop in order: runs of contiguous free
+// blocks' triangles (merged across block boundaries, so small blocks still fill whole
+// vectors), cut into kChunk triangles.
+template <class F>
+void for_each_chunk(const Model& model, F&& f) {
+  const std::size_t nb = model.blocks.size();
+  for (std::size_t b = 0; b < nb;) {
+    if (model.blocks[b].fixed) {
+      ++b;
+      continue;
+    }
+    const Index begin = model.blocks[b].first_tri;
+    Index end = begin + model.blocks[b].tri_count;
+    for (++b; b < nb && !model.blocks[b].fixed && model.blocks[b].first_tri == end; ++b)
+      end += model.blocks[b].tri_count;
+    for (Index c0 = begin; c0 < end; c0 += kChunk) f(c0, int(std::min<Index>(kChunk, end - c0)));
+  }
+}
+
 ElementStageResult result_of(const ChunkSums& s) {
   ElementStageResult out;
   out.strain_energy = s.energy;
@@ -135,21 +155,15 @@ ElementStageResult element_loop(Model& model, const CstLaw& law, double* viscous
   double* __restrict fy = model.nodes.fy.data();
   alignas(64) double cfx[3][kChunk], cfy[3][kChunk];
   ChunkSums sum;
-  // Triangles of one block are contiguous: flat loops per free block.
-  for (const Block& block : model.blocks) {
-    if (block.fixed) continue;
-    const Index end = block.first_tri + block.tri_count;
-    for (Index c0 = block.first_tri; c0 < end; c0 += kChunk) {
-      const int len = int(std::min<Index>(kChunk, end - c0));
-      const ChunkSums c = chunk_forces<kViscous, kDamped>(a, law, viscous, c0, len, cfx[0], cfy[0]);
-      sum.energy += c.energy, sum.power += c.power, sum.previous_power += c.previous_power;
-      for (int j = 0; j < len; ++j) {  // scatter
-        const Index e = c0 + j, i0 = a.n0[e], i1 = a.n1[e], i2 = a.n2[e];
-        fx[i0] += cfx[0][j], fx[i1] += cfx[1][j], fx[i2] += cfx[2][j];
-        fy[i0] += cfy[0][j], fy[i1] += cfy[1][j], fy[i2] += cfy[2][j];
-      }
+  for_each_chunk(model, [&](Index c0, int len) {
+    const ChunkSums c = chunk_forces<kViscous, kDamped>(a, law, viscous, c0, len, cfx[0], cfy[0]);
+    sum.energy += c.energy, sum.power += c.power, sum.previous_power += c.previous_power;
+    for (int j = 0; j < len; ++j) {  // scatter
+      const Index e = c0 + j, i0 = a.n0[e], i1 = a.n1[e], i2 = a.n2[e];
+      fx[i0] += cfx[0][j], fx[i1] += cfx[1][j], fx[i2] += cfx[2][j];
+      fy[i0] += cfy[0][j], fy[i1] += cfy[1][j], fy[i2] += cfy[2][j];
     }
-  }
+  });
   return result_of(sum);
 }
 
@@ -157,14 +171,10 @@ ElementStageResult element_loop(Model& model, const CstLaw& law, double* viscous
 void build_workspace(const Model& model, ElementWorkspace& w) {
   w.chunk_first.clear();
   w.chunk_len.clear();
-  for (const Block& block : model.blocks) {
-    if (block.fixed) continue;
-    const Index end = block.first_tri + block.tri_count;
-    for (Index c0 = block.first_tri; c0 < end; c0 += kChunk) {
-      w.chunk_first.push_back(c0);
-      w.chunk_len.push_back(int(std::min<Index>(kChunk, end - c0)));
-    }
-  }
+  for_each_chunk(model, [&w](Index c0, int len) {
+    w.chunk_first.push_back(c0);
+    w.chunk_len.push_back(len);
+  });
   const std::size_t chunks = w.chunk_first.size(), slots = 3 * kChunk * chunks;
   w.corner_fx.assign(slots, 0.0);
   w.corner_fy.assign(slots, 0.0);

@@ -301,7 +301,7 @@ constexpr int kElementChunk = 32;
 // Scratch of the threaded element stage, built at its first use for a model and kept by the
 // Simulation (the triangle and node sets and the blocks' fixed flags must not change after).
 //   chunk_first[k], chunk_len[k]: triangles [first, first + len) of chunk k, in the order of
-//     the one-thread loop (free blocks in order, kElementChunk triangles at a time);
+//     the one-thread loop (runs of contiguous free blocks, kElementChunk triangles at a time);
 //   corner_fx/fy[k * 3 kElementChunk + a kElementChunk + j]: force on corner a of triangle
 //     chunk_first[k] + j (the chunk buffer layout of the kernel);
 //   node_begin / node_corner (CSR, size nodes + 1 / corners of free triangles): the corner

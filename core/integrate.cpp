@@ -30,16 +30,28 @@ struct NodeRange {
   Index begin, end;
 };
 
+// Hot node arrays (STYLE.md "Hot loops").
+struct NodeArrays {
+  double *x, *y, *vx, *vy;
+  const double *fx, *fy, *inv_mass, *mass;
+};
+
+NodeArrays arrays_of(Nodes& n) {
+  return NodeArrays{n.x.data(),  n.y.data(),  n.vx.data(),       n.vy.data(),
+                    n.fx.data(), n.fy.data(), n.inv_mass.data(), n.mass.data()};
+}
+
 // Velocity then position update of nodes [begin, end); adds m v^- . v^+ into twice_kinetic.
-inline void update_nodes(Nodes& nodes, double dt, Index begin, Index end, double& twice_kinetic) {
-  double* __restrict x = nodes.x.data();
-  double* __restrict y = nodes.y.data();
-  double* __restrict vx = nodes.vx.data();
-  double* __restrict vy = nodes.vy.data();
-  const double* __restrict fx = nodes.fx.data();
-  const double* __restrict fy = nodes.fy.data();
-  const double* __restrict inv_mass = nodes.inv_mass.data();
-  const double* __restrict mass = nodes.mass.data();
+inline void update_nodes(const NodeArrays& a, double dt, Index begin, Index end,
+                         double& twice_kinetic) {
+  double* __restrict x = a.x;
+  double* __restrict y = a.y;
+  double* __restrict vx = a.vx;
+  double* __restrict vy = a.vy;
+  const double* __restrict fx = a.fx;
+  const double* __restrict fy = a.fy;
+  const double* __restrict inv_mass = a.inv_mass;
+  const double* __restrict mass = a.mass;
   double k2 = twice_kinetic;
   for (Index i = begin; i < end; ++i) {
     const double h = dt * inv_mass[i];
@@ -94,14 +106,13 @@ void clear_forces(Nodes& nodes) {
 }
 
 double integrate_central_difference(Model& model, double dt) {
-  Nodes& nodes = model.nodes;
+  const NodeArrays a = arrays_of(model.nodes);
   double twice_kinetic = 0.0;
-  if (free_node_count(model) < kParallelNodes) {
+  if (model.nodes.size() < kParallelNodes || free_node_count(model) < kParallelNodes) {
     // Nodes of one block are contiguous: one flat loop per free block, one running sum.
     for (const Block& block : model.blocks) {
       if (block.fixed) continue;
-      update_nodes(nodes, dt, block.first_node, block.first_node + block.node_count,
-                   twice_kinetic);
+      update_nodes(a, dt, block.first_node, block.first_node + block.node_count, twice_kinetic);
     }
     return 0.5 * twice_kinetic;
   }
@@ -111,7 +122,7 @@ double integrate_central_difference(Model& model, double dt) {
   const std::int64_t count = std::int64_t(chunks.size());
 #pragma omp parallel for schedule(static) if (threads_available())
   for (std::int64_t k = 0; k < count; ++k)
-    update_nodes(nodes, dt, chunks[k].begin, chunks[k].end, sums[k]);
+    update_nodes(a, dt, chunks[k].begin, chunks[k].end, sums[k]);
   for (const double s : sums) twice_kinetic += s;
   return 0.5 * twice_kinetic;
 }
