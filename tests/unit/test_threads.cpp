@@ -4,7 +4,9 @@
 // contact/contact.cpp kParallelPairs) and are built so that no result depends on the thread
 // count. Two scenes: the shipped arch (below every threshold: the one-thread path must be
 // taken whatever the thread count) and church A meshed at through_thickness 6 (14240
-// triangles, 10687 nodes: the threaded element and integration paths run).
+// triangles, 10687 nodes, 200 steps: the threaded element and integration paths run). On a
+// loaded machine the two-thread run is the slow part (libgomp spins at barriers while the
+// partner thread waits for a core: docs/benchmarks.md).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -75,9 +77,9 @@ TEST(Threads, ArchOneAndTwoThreadsBitIdentical) {
 
 TEST(Threads, LargeChurchOneAndTwoThreadsBitIdentical) {
   const std::vector<std::string> set = {"mesh.through_thickness=6"};
-  const Snapshot one = run("church_a.toml", set, 300, 1);
+  const Snapshot one = run("church_a.toml", set, 200, 1);
   ASSERT_GE(one.x.size(), 8192u);  // above the element and integration thresholds
-  const Snapshot two = run("church_a.toml", set, 300, 2);
+  const Snapshot two = run("church_a.toml", set, 200, 2);
   ASSERT_GT(one.ledger.kinetic, 0.0);
   ASSERT_GT(one.ledger.damping_dissipated, 0.0);
   expect_identical(one, two);
