@@ -103,8 +103,8 @@ int main() {
   shuffle_blocks(shuffled);
   compare("rect-shuf", shuffled);
   compare("wall", bench::wall_model(20, 20, 16, 8));
-  const Config church = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/church_a.toml",
-                                  {"mesh.size=0.03"});
+  const Config church =
+      load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/church_a.toml", {"mesh.size=0.03"});
   compare("church", make_simulation(church).model);
   return 0;
 }

@@ -6,12 +6,11 @@
 // Run: build-*/bench_wall [courses per_course [steps [cells_x cells_y [runs]]]]
 // (runs: the thread count of each timed run, default "1212").
 // Prints, per run: threads, wall s, process CPU s, the main thread's CPU s, triangle-steps
-// per wall second, the stage times (wall) and the load average before and after; runs alternate 1, 2, 1, 2 threads from
-// copies of the same settled state, and the final states are compared bit for bit.
-// With OMP_WAIT_POLICY=passive a waiting thread sleeps, so the main thread's CPU time is the
-// serial work plus its share of the parallel work: one-thread CPU / main-thread CPU estimates
-// the speed-up on an idle machine (barrier latencies excluded) when the load prevents
-// measuring it in wall time.
+// per wall second, the stage times (wall) and the load average before and after. Every run
+// starts from a copy of the same settled state; the final states are compared bit for bit.
+// With OMP_WAIT_POLICY=passive a waiting thread sleeps: the main thread's CPU time is then the
+// serial work plus its share of the parallel work (docs/benchmarks.md uses per-thread
+// instruction counts for the same purpose, being independent of the load).
 // Memory: VmRSS (/proc/self/status) before building, after building and after 100 steps on
 // two threads (contact pairs and the threaded element workspace allocated), divided by the
 // triangle count. Use OMP_WAIT_POLICY=passive on a shared machine (docs/benchmarks.md).
@@ -71,14 +70,16 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 100; ++k) advance(settled);  // joints close; contact pairs allocated
   const double rss2 = vm_rss_kib();
   const double tris = double(settled.model.tris.size());
-  std::printf("wall %d x %d blocks of %d x %d cells: %.0f triangles, %d nodes, %zu candidate "
-              "pairs, dt %.3e s\n",
-              courses, per_course, cells_x, cells_y, tris, settled.model.nodes.size(),
-              settled.contact.candidate_pairs(), settled.ctx.dt);
-  std::printf("memory: model + contact setup %.0f B/triangle, + step state (pairs, viscous buffer, "
-              "element workspace) %.0f "
-              "B/triangle (VmRSS %.0f -> %.0f -> %.0f KiB)\n",
-              1024.0 * (rss1 - rss0) / tris, 1024.0 * (rss2 - rss0) / tris, rss0, rss1, rss2);
+  std::printf(
+      "wall %d x %d blocks of %d x %d cells: %.0f triangles, %d nodes, %zu candidate "
+      "pairs, dt %.3e s\n",
+      courses, per_course, cells_x, cells_y, tris, settled.model.nodes.size(),
+      settled.contact.candidate_pairs(), settled.ctx.dt);
+  std::printf(
+      "memory: model + contact setup %.0f B/triangle, + step state (pairs, viscous buffer, "
+      "element workspace) %.0f "
+      "B/triangle (VmRSS %.0f -> %.0f -> %.0f KiB)\n",
+      1024.0 * (rss1 - rss0) / tris, 1024.0 * (rss2 - rss0) / tris, rss0, rss1, rss2);
 
   std::vector<double> reference_x;
   for (const char run : runs) {
@@ -92,18 +93,19 @@ int main(int argc, char** argv) {
     const double main0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; k < steps; ++k) advance(sim);
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double cpu = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
     const double main_cpu = cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - main0;
     const StageTimers& t = sim.timers;
     const double ms = 1e3 / steps;
-    std::printf("threads %d: %d steps, wall %.3f s, CPU %.3f s (main thread %.3f s), %.3g "
-                "tri-steps/wall s (per step ms: broad %.3f elements %.3f contact %.3f loads %.3f "
-                "integrate %.3f), load %s -> %s\n",
-                threads, steps, wall, cpu, main_cpu, tris * steps / wall, t.broad * ms,
-                t.elements * ms,
-                t.contact * ms, t.loads * ms, t.integrate * ms, load_before.c_str(),
-                load_average().c_str());
+    std::printf(
+        "threads %d: %d steps, wall %.3f s, CPU %.3f s (main thread %.3f s), %.3g "
+        "tri-steps/wall s (per step ms: broad %.3f elements %.3f contact %.3f loads %.3f "
+        "integrate %.3f), load %s -> %s\n",
+        threads, steps, wall, cpu, main_cpu, tris * steps / wall, t.broad * ms, t.elements * ms,
+        t.contact * ms, t.loads * ms, t.integrate * ms, load_before.c_str(),
+        load_average().c_str());
     if (reference_x.empty()) {
       reference_x = sim.model.nodes.x;
     } else if (std::memcmp(reference_x.data(), sim.model.nodes.x.data(),

@@ -74,8 +74,7 @@ inline Simulation bench_simulation(Model model) {
   return sim;
 }
 
-inline Simulation wall_simulation(int courses, int per_course, int cells_x = 16,
-                                  int cells_y = 8) {
+inline Simulation wall_simulation(int courses, int per_course, int cells_x = 16, int cells_y = 8) {
   return bench_simulation(wall_model(courses, per_course, cells_x, cells_y));
 }
 

@@ -38,7 +38,9 @@ namespace {
 constexpr Index kParallelTriangles = 8192;
 constexpr int kChunk = kElementChunk;
 
-bool threads_available() { return omp_get_max_threads() > 1 && !omp_in_parallel(); }
+bool threads_available() {
+  return omp_get_max_threads() > 1 && !omp_in_parallel();
+}
 
 // Hot arrays of the element stage as flat pointers (STYLE.md "Hot loops").
 struct ElementArrays {
@@ -52,9 +54,9 @@ struct ElementArrays {
 ElementArrays arrays_of(const Model& model) {
   const Nodes& n = model.nodes;
   const Triangles& t = model.tris;
-  return ElementArrays{n.x.data(),   n.y.data(),   n.vx.data(),  n.vy.data(),
-                       t.n0.data(),  t.n1.data(),  t.n2.data(),  t.b00.data(),
-                       t.b01.data(), t.b10.data(), t.b11.data(), t.area0.data(),
+  return ElementArrays{n.x.data(),         n.y.data(),           n.vx.data(),  n.vy.data(),
+                       t.n0.data(),        t.n1.data(),          t.n2.data(),  t.b00.data(),
+                       t.b01.data(),       t.b10.data(),         t.b11.data(), t.area0.data(),
                        model.out_of_plane, std::size_t(t.size())};
 }
 
@@ -111,8 +113,8 @@ template <bool kViscous, bool kDamped>
       // Power of the previous step's viscous stress at the current velocities; then keep
       // this step's.
       double* __restrict pv = viscous + e;
-      pp += pv[0] * f.rate[0] + pv[nt] * f.rate[1] + pv[2 * nt] * f.rate[2] +
-            pv[3 * nt] * f.rate[3];
+      pp +=
+          pv[0] * f.rate[0] + pv[nt] * f.rate[1] + pv[2 * nt] * f.rate[2] + pv[3 * nt] * f.rate[3];
       pv[0] = f.viscous[0], pv[nt] = f.viscous[1];
       pv[2 * nt] = f.viscous[2], pv[3 * nt] = f.viscous[3];
     }

@@ -24,7 +24,9 @@ namespace {
 constexpr Index kParallelNodes = 8192;
 constexpr Index kNodeChunk = 2048;
 
-bool threads_available() { return omp_get_max_threads() > 1 && !omp_in_parallel(); }
+bool threads_available() {
+  return omp_get_max_threads() > 1 && !omp_in_parallel();
+}
 
 struct NodeRange {
   Index begin, end;

@@ -38,15 +38,16 @@ std::vector<Index> block_node_rank(const Model& model, const Block& b) {
     adjncy.insert(adjncy.end(), adj[i].begin(), adj[i].end());
     xadj[i + 1] = idx_t(adjncy.size());
   }
-  idx_t nvtxs = n, ncon = 1, nparts = std::max<idx_t>(2, (n + kOrderPartNodes - 1) / kOrderPartNodes);
+  idx_t nvtxs = n, ncon = 1,
+        nparts = std::max<idx_t>(2, (n + kOrderPartNodes - 1) / kOrderPartNodes);
   idx_t options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_SEED] = 1;
   idx_t objval = 0;
   std::vector<idx_t> part(std::size_t(n), 0);
-  const int status = METIS_PartGraphRecursive(&nvtxs, &ncon, xadj.data(), adjncy.data(), nullptr,
-                                              nullptr, nullptr, &nparts, nullptr, nullptr,
-                                              options, &objval, part.data());
+  const int status =
+      METIS_PartGraphRecursive(&nvtxs, &ncon, xadj.data(), adjncy.data(), nullptr, nullptr, nullptr,
+                               &nparts, nullptr, nullptr, options, &objval, part.data());
   if (status != METIS_OK) throw std::runtime_error("METIS_PartGraphRecursive failed");
   std::vector<Index> order(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), 0);
