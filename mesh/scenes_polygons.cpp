@@ -394,6 +394,20 @@ Scene build_polygons_scene(const Config& config) {
   }
   const double h = element_size(config, reference);
   scene.element_size = h;
+  // Refuse too fine a mesh before outlining: every edge is cut at the element size below, so a
+  // mistyped coordinate (2147483648 for 2, fuzzing of issue 8) made billions of boundary points
+  // and exhausted memory before mesh_scene's triangle budget could see the areas. Same
+  // estimate as there (~5 triangles per size^2), plus one per boundary point.
+  double estimate = 0.0;
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (scene.blocks[b].mesher != BlockSpec::Mesher::Polygon) continue;
+    const double size = (scene.blocks[b].fixed ? kFixedCoarsening : 1.0) * std::sqrt(2.0) * h;
+    const auto& p = outlines[b];
+    double perimeter = 0.0;
+    for (std::size_t e = 0; e < p.size(); ++e) perimeter += norm(p[(e + 1) % p.size()] - p[e]);
+    estimate += perimeter / h + 5.0 * std::abs(polygon_area(p)) / (size * size);
+  }
+  check_triangle_budget(config, estimate);
   // Conforming faces: a vertex of another block lying on an edge (a T-junction, e.g. a block
   // standing on a longer ground edge) is inserted into that edge, so both blocks get a node
   // there; then every edge is cut from its lexicographically smaller end so that a face shared
