@@ -140,11 +140,6 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
   const std::string ckpt_path = checkpoint_path(opts, out_path, config);
   const double friction = config.contact.friction;
   const std::uint64_t fingerprint = simulation_fingerprint(sim, friction);
-  if (checkpoints && friction > 0.0 && !contact_history_saved())
-    throw DeckError(config.deck_path +
-                    ": --checkpoint-every needs contact.friction = 0 in this "
-                    "build (the contact friction history cannot be saved yet; got " +
-                    std::to_string(friction) + ")");
 
   RunBookkeeping book;
   if (!opts.restart.empty()) {

@@ -129,10 +129,6 @@ void write_file_atomically(const std::string& path, const std::string& data) {
 
 }  // namespace
 
-bool contact_history_saved() {
-  return true;  // ContactSystem::save_state/restore_state (contact/contact.hpp)
-}
-
 std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
   const Model& m = sim.model;
   Fnv f;

@@ -46,10 +46,6 @@
 
 namespace voussoir {
 
-// True: checkpoints keep the contact friction history (ContactSystem::save_state). Kept for
-// callers written when it could be false (frictionless runs only).
-bool contact_history_saved();
-
 // Fingerprint of everything make_simulation rebuilds from the deck: node and triangle counts,
 // reference positions, masses, connectivity, material, out-of-plane thickness, dt, law
 // constants, damping, body loads, contact switch, penalty and buffer, and `friction` (the
