@@ -4,7 +4,7 @@
 // grid of cells_x x cells_y cells (two triangles each, alternating diagonals); odd courses are
 // shifted by half a block and end with half blocks. Material of cases/circular_arch.toml
 // (E 40 GPa, nu 0.2, rho 2000), friction 0.6, default penalty (100 x Lame lambda) and
-// damping (factor 1), gravity, dt = 0.5 x the stable step (the decks' default safety).
+// damping (factor 1), gravity, dt = 0.5 x the stable step.
 // 20 courses x 20 blocks of 16 x 8 cells: 102400 + 512 triangles.
 
 #include <array>
