@@ -34,13 +34,17 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
 
   const double dt_stable = stable_time_step(sim);
   // Infinite when nothing can vibrate (no free block); zero or NaN only when the material,
-  // mesh or penalty overflow double precision: refused, never run.
-  if (!(dt_stable > 0.0)) {
+  // mesh, damping or penalty overflow double precision, and below kMinStableStep only for
+  // absurd values of them (a damping factor of 9e18 gave 1.9e-25 s: fuzzing, issue 8): a
+  // microsecond of such a run is 1e9 steps. Refused, never run.
+  constexpr double kMinStableStep = 1e-15;  // [s]; masonry models sit at 1e-8 to 1e-5 s
+  if (!(dt_stable >= kMinStableStep)) {
     std::ostringstream msg;
     msg << config.deck_path << ": the stable time step of this model is " << dt_stable
-        << " s: the material (young = " << config.material.young
-        << " Pa, density = " << config.material.density << " kg/m3), the mesh or the contact "
-        << "penalty (" << cp.penalty << " Pa) are out of range";
+        << " s (at least " << kMinStableStep << " s needed): the material (young = "
+        << config.material.young << " Pa, density = " << config.material.density
+        << " kg/m3), solver.damping_factor = " << config.solver.damping_factor
+        << ", the mesh or the contact penalty (" << cp.penalty << " Pa) are out of range";
     throw DeckError(msg.str());
   }
   double dt = config.solver.dt_safety * dt_stable;

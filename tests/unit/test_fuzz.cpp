@@ -135,6 +135,29 @@ TEST(FuzzFindings, ChurchHugeOuterWidth) {
   EXPECT_TRUE(ok.exited && ok.status == 0) << ok.describe() << "\n" << ok.err;
 }
 
+// mesh/scenes_church.cpp: supports of 5e-324 m (or 1e-6 m) were outlined into ever more course
+// slivers and `check` never finished (slow fuzz tier, session 2).
+TEST(FuzzFindings, ChurchTinyHeight) {
+  for (const std::string& set : {std::string("model.height=5e-324"), std::string("model.height=1e-6")}) {
+    const ProcessResult r = check_with("church_a.toml", {set});
+    expect_refused_or_accepted(r);
+    EXPECT_TRUE(r.exited && r.status == 2) << set << ": " << r.describe();
+    EXPECT_NE(r.err.find("at least 0.01 x the largest span (6 m)"), std::string::npos) << r.err;
+  }
+  const ProcessResult ok = check_with("church_a.toml", {"model.height=0.5"});
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.describe() << "\n" << ok.err;
+}
+
+// drivers/setup.cpp: a damping factor of 9e18 made a stable step of 1.9e-25 s, refused only by
+// the run loop (exit 1) after set-up (slow fuzz tier, session 2). Now refused up front.
+TEST(FuzzFindings, AbsurdDampingTimeStep) {
+  const ProcessResult r = check_with("church_a.toml", {"solver.damping_factor=9223372036854775807"});
+  expect_refused_or_accepted(r);
+  EXPECT_TRUE(r.exited && r.status == 2) << r.describe();
+  EXPECT_NE(r.err.find("solver.damping_factor = "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("at least 1e-15 s needed"), std::string::npos) << r.err;
+}
+
 // mesh/scenes_polygons.cpp: block 0 = (-0.25, 0), (0.25, 0), (0.25, 2147483648), (-1.75, -0.25),
 // a 2e9 m tall sliver reaching into the ground -> std::bad_alloc (exit 1).
 TEST(FuzzFindings, PolygonHugeCoordinate) {
