@@ -12,7 +12,6 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "core/cst.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/run.hpp"
@@ -40,19 +39,6 @@ nlohmann::json control_json(const std::vector<ControlSummary>& control) {
                          {"final_ux", c.final_ux},
                          {"final_uy", c.final_uy}};
   return out;
-}
-
-// Cauchy stress (sxx, syy, sxy) of every triangle, interleaved, for snapshots.
-std::vector<double> triangle_stresses(const Simulation& sim) {
-  const CstLaw law{sim.ctx.lame_lambda, sim.ctx.shear_modulus, sim.ctx.eta};
-  std::vector<double> s(3 * static_cast<size_t>(sim.model.tris.size()));
-  for (Index e = 0; e < sim.model.tris.size(); ++e) {
-    const Stress2 st = triangle_cauchy_stress(sim.model, e, law);
-    s[3 * e] = st.xx;
-    s[3 * e + 1] = st.yy;
-    s[3 * e + 2] = st.xy;
-  }
-  return s;
 }
 
 SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {

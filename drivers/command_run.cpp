@@ -28,19 +28,6 @@
 namespace voussoir {
 namespace {
 
-// Cauchy stress (sxx, syy, sxy) of every triangle, interleaved, for snapshots.
-std::vector<double> triangle_stresses(const Simulation& sim) {
-  const CstLaw law{sim.ctx.lame_lambda, sim.ctx.shear_modulus, sim.ctx.eta};
-  std::vector<double> s(3 * static_cast<size_t>(sim.model.tris.size()));
-  for (Index e = 0; e < sim.model.tris.size(); ++e) {
-    const Stress2 st = triangle_cauchy_stress(sim.model, e, law);
-    s[3 * e] = st.xx;
-    s[3 * e + 1] = st.yy;
-    s[3 * e + 2] = st.xy;
-  }
-  return s;
-}
-
 SeriesRecord series_record(const Simulation& sim) {
   const EnergyLedger& l = sim.ledger;
   SeriesRecord r;

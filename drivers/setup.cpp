@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/cst.hpp"
 #include "io/deck.hpp"
 #include "mesh/scene.hpp"
 
@@ -66,6 +67,18 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
     info->eta = sim.ctx.eta;
   }
   return sim;
+}
+
+std::vector<double> triangle_stresses(const Simulation& sim) {
+  const CstLaw law{sim.ctx.lame_lambda, sim.ctx.shear_modulus, sim.ctx.eta};
+  std::vector<double> s(3 * static_cast<size_t>(sim.model.tris.size()));
+  for (Index e = 0; e < sim.model.tris.size(); ++e) {
+    const Stress2 st = triangle_cauchy_stress(sim.model, e, law);
+    s[3 * e] = st.xx;
+    s[3 * e + 1] = st.yy;
+    s[3 * e + 2] = st.xy;
+  }
+  return s;
 }
 
 }  // namespace voussoir

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/step.hpp"
 #include "io/config.hpp"
@@ -31,5 +32,8 @@ Simulation make_simulation(const Config& config, SetupInfo* info = nullptr);
 
 // Sets the body load of the context: gravity down, lambda g horizontal.
 void set_static_load(Simulation& sim, double gravity, double lambda);
+
+// Cauchy stress (sxx, syy, sxy) of every triangle, interleaved, for output snapshots.
+std::vector<double> triangle_stresses(const Simulation& sim);
 
 }  // namespace voussoir
