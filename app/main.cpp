@@ -96,6 +96,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   capacity->add_option("--max-time", cap_opts.criteria.max_time, "trial time limit [s]")
       ->check(CLI::PositiveNumber);
+  capacity->add_option("--settle-time", cap_opts.criteria.settle_max_time,
+                       "longest settle under gravity before the trials [s] (default 2)")
+      ->check(CLI::PositiveNumber);
 
   voussoir::LimitCommandOptions limit_opts;
   CLI::App* limit =

@@ -301,7 +301,8 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   if (!settled.settled)
     throw RunError("the structure does not come to rest under gravity alone within " +
                    std::to_string(crit.settle_max_time) +
-                   " s: it has no gravity capacity (lambda* = 0) or needs a longer settle");
+                   " s: it has no gravity capacity (lambda* = 0) or needs a longer settle "
+                   "(capacity --settle-time)");
   Journal journal(search.journal, fingerprint(settled, crit));
 
   // Runs the lambdas not in the journal (in parallel when cores allow); returns all results
