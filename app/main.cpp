@@ -135,6 +135,9 @@ int main(int argc, char** argv) {
       ->required();
   sweep->add_option("--csv", sweep_opts.csv, "CSV output (default sweep.csv)");
   sweep->add_option("--plot", sweep_opts.plot, "PNG plot of lambda* over the grid");
+  sweep->add_option("--settle-time", sweep_opts.criteria.settle_max_time,
+                    "longest settle under gravity before each cell's trials [s] (default 2)")
+      ->check(CLI::PositiveNumber);
   sweep->add_option("--resume", sweep_opts.resume,
                     "journal of finished cells: created, or resumed after a kill");
   sweep->add_option("--points", sweep_opts.points, "trial lambdas per round (default 2)")

@@ -69,7 +69,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
 
   std::vector<CapacityResult> results(cells);
   std::vector<std::string> errors(cells);
-  const TrialCriteria criteria;
+  const TrialCriteria& criteria = opts.criteria;
   // Resume: the journal holds one JSON line per finished cell ({"cell": i, "values": [...],
   // result}); cells found there with the same values are not run again.
   std::vector<bool> finished(cells, false);

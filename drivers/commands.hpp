@@ -81,6 +81,7 @@ struct SweepOptions {
   std::string plot;                  // --plot FILE.png (drawn by scripts/plot_sweep)
   std::string resume;                // --resume FILE: journal of finished cells
   int points = 2;
+  TrialCriteria criteria;            // --settle-time (the other trial criteria: defaults)
 };
 
 // Runs capacity over the grid; `deck_path` and `sets` rebuild the deck per cell.
