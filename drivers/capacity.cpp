@@ -20,6 +20,23 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Largest centroid displacement [m] and rotation [rad] of the free blocks since `base`.
+struct MotionExtent {
+  double displacement = 0.0, rotation = 0.0;
+};
+
+MotionExtent largest_motion(const Model& model, const std::vector<BlockMotion>& base) {
+  const std::vector<BlockMotion> now = block_motions(model);
+  MotionExtent m;
+  for (size_t b = 0; b < now.size(); ++b) {
+    if (model.blocks[b].fixed) continue;
+    m.displacement =
+        std::max(m.displacement, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
+    m.rotation = std::max(m.rotation, std::abs(now[b].rotation - base[b].rotation));
+  }
+  return m;
+}
+
 }  // namespace
 
 SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet) {
@@ -32,6 +49,8 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   const double dt = sim.ctx.dt;
   const long long every = std::max(1LL, std::llround(kSampleTime / dt));
   const double v_rest = crit.rest_speed * std::sqrt(std::max(s.gravity, 1e-12) * s.l_ref);
+  const double d_collapse = crit.collapse_displacement * s.l_ref;
+  const std::vector<BlockMotion> start = block_motions(sim.model);
   RestDetector rest(v_rest, crit.hold_time);
   while (sim.ctx.time < crit.settle_max_time) {
     const double ramp = std::min(1.0, sim.ctx.time / crit.ramp_time);
@@ -39,6 +58,13 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
     advance(sim);
     if (sim.step % every != 0) continue;
     check_finite(sim);
+    const MotionExtent moved = largest_motion(sim.model, start);
+    s.max_displacement = moved.displacement;
+    s.max_rotation = moved.rotation;
+    if (moved.displacement > d_collapse || moved.rotation > crit.collapse_rotation) {
+      s.collapsed = true;  // no need to wait for the time limit
+      break;
+    }
     if (sim.ctx.time < crit.ramp_time) continue;
     if (rest.update(sim.ctx.time, max_free_speed(sim.model.nodes), sim.ledger.kinetic)) {
       s.settled = true;
@@ -51,8 +77,26 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   s.wall_s = seconds_since(t0);
   if (!quiet)
     std::fprintf(stderr, "settled under gravity: %s after %.3f s (%lld steps, %.2f s wall)\n",
-                 s.settled ? "at rest" : "NOT at rest", s.settle_time, s.steps, s.wall_s);
+                 s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"),
+                 s.settle_time, s.steps, s.wall_s);
   return s;
+}
+
+std::string unsettled_message(const SettledState& s, const TrialCriteria& crit) {
+  char buf[320];
+  if (s.collapsed)
+    std::snprintf(buf, sizeof buf,
+                  "the structure collapses under gravity alone: a block moved %.3g m and "
+                  "rotated %.3g rad within %.3g s of settling (no gravity capacity, "
+                  "lambda* = 0)",
+                  s.max_displacement, s.max_rotation, s.settle_time);
+  else
+    std::snprintf(buf, sizeof buf,
+                  "the structure does not come to rest under gravity alone within %g s (largest "
+                  "block motion %.3g m, %.3g rad): it creeps towards collapse or needs a longer "
+                  "settle (--settle-time)",
+                  crit.settle_max_time, s.max_displacement, s.max_rotation);
+  return buf;
 }
 
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& crit) {
@@ -81,13 +125,8 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
     if ((sim.step - step_start) % every != 0) continue;
     check_finite(sim);
     const double elapsed = sim.ctx.time - t_start;
-    const std::vector<BlockMotion> now = block_motions(sim.model);
-    double dmax = 0.0, rmax = 0.0;
-    for (size_t b = 0; b < now.size(); ++b) {
-      if (sim.model.blocks[b].fixed) continue;
-      dmax = std::max(dmax, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
-      rmax = std::max(rmax, std::abs(now[b].rotation - base[b].rotation));
-    }
+    const MotionExtent moved = largest_motion(sim.model, base);
+    const double dmax = moved.displacement, rmax = moved.rotation;
     r.max_displacement = dmax;
     r.max_rotation = rmax;
     measure.push_back(std::max(dmax / d_collapse, rmax / crit.collapse_rotation));
@@ -298,11 +337,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   const SettledState settled = settle(config, crit, quiet);
   res.triangles = settled.sim.model.tris.size();
   res.dt = settled.sim.ctx.dt;
-  if (!settled.settled)
-    throw RunError("the structure does not come to rest under gravity alone within " +
-                   std::to_string(crit.settle_max_time) +
-                   " s: it has no gravity capacity (lambda* = 0) or needs a longer settle "
-                   "(capacity --settle-time)");
+  if (!settled.settled) throw RunError(unsettled_message(settled, crit));
   Journal journal(search.journal, fingerprint(settled, crit));
 
   // Runs the lambdas not in the journal (in parallel when cores allow); returns all results

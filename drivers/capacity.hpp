@@ -42,7 +42,7 @@ struct TrialCriteria {
   double rest_speed = 1e-3;            // x sqrt(g L_ref)
   double hold_time = 0.1;              // [s]
   double max_time = 3.0;               // [s] of simulated time after settling
-  double settle_max_time = 2.0;        // [s]
+  double settle_max_time = 5.0;        // [s]; a collapse under gravity ends it sooner
 };
 
 struct TrialResult {
@@ -67,10 +67,18 @@ struct SettledState {
   long long steps = 0;
   double wall_s = 0.0;
   bool settled = false;
+  bool collapsed = false;              // a block passed the collapse criterion while settling
+  double max_displacement = 0.0;       // [m] largest block motion while settling
+  double max_rotation = 0.0;           // [rad]
 };
 
-// Settles the model of `config` under gravity (lambda = 0).
+// Settles the model of `config` under gravity (lambda = 0): until rest (the trial criteria's
+// rest rule), a collapse (their displacement or rotation rule: no gravity capacity), or
+// `settle_max_time`.
 SettledState settle(const Config& config, const TrialCriteria& criteria, bool quiet);
+
+// Why a settle did not end at rest, for the error of the commands that need rest.
+std::string unsettled_message(const SettledState& settled, const TrialCriteria& criteria);
 
 // One trial from a copy of the settled state.
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria);

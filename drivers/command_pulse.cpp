@@ -71,9 +71,7 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
                     ": load.base.signal = \"none\": `voussoir pulse` needs a base signal "
                     "(windowed_sine, sine_pulse or file)");
   const SettledState settled = settle(config, crit.settle, common.quiet);
-  if (!settled.settled)
-    throw RunError("the structure does not come to rest under gravity alone within " +
-                   std::to_string(crit.settle.settle_max_time) + " s");
+  if (!settled.settled) throw RunError(unsettled_message(settled, crit.settle));
   const std::vector<ControlPoint> points = find_control_points(settled.sim.model);
 
   const std::string out_path = opts.output.empty() ? config.output.file : opts.output;
@@ -214,9 +212,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   const double a0 = std::max(lambda_star, 0.01);
 
   const SettledState settled = settle(config, crit.settle, common.quiet);
-  if (!settled.settled)
-    throw RunError("the structure does not come to rest under gravity alone within " +
-                   std::to_string(crit.settle.settle_max_time) + " s");
+  if (!settled.settled) throw RunError(unsettled_message(settled, crit.settle));
 
   // Lowest frequencies (longest pulses) first for the dynamic schedule.
   std::vector<double> freqs = opts.freqs;

@@ -45,9 +45,40 @@ TEST(Capacity, BlockSlidesAtFriction) {
   EXPECT_EQ(r.hinges.front().kind, "sliding");
   // Every trial lies on its side of the final bracket.
   for (const TrialResult& t : r.trials) {
-    if (t.lambda <= r.lo) EXPECT_FALSE(t.collapsed) << t.lambda;
-    if (t.lambda >= r.hi) EXPECT_TRUE(t.collapsed) << t.lambda;
+    if (t.lambda <= r.lo) {
+      EXPECT_FALSE(t.collapsed) << t.lambda;
+    }
+    if (t.lambda >= r.hi) {
+      EXPECT_TRUE(t.collapsed) << t.lambda;
+    }
   }
+}
+
+// A block on a ground inclined at 20 degrees with mu = 0.2 < tan 20 = 0.36 slides off under
+// gravity alone: the settle stops at the collapse criterion, long before its time limit, and
+// the search refuses with the reason (lambda* = 0). With mu = 0.6 the same block comes to rest.
+TEST(Capacity, CollapseUnderGravityEndsTheSettleEarly) {
+  auto deck = [](double mu) {
+    Config c = block_deck(mu);
+    c.model.incline = 20.0;
+    return c;
+  };
+  const TrialCriteria crit;
+  const SettledState sliding = settle(deck(0.2), crit, true);
+  EXPECT_FALSE(sliding.settled);
+  EXPECT_TRUE(sliding.collapsed);
+  EXPECT_LT(sliding.settle_time, 0.5 * crit.settle_max_time);
+  EXPECT_GT(sliding.max_displacement, crit.collapse_displacement * sliding.l_ref);
+  try {
+    find_capacity(deck(0.2), crit, 2, true);
+    FAIL() << "a block sliding under gravity got a capacity";
+  } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("collapses under gravity alone"), std::string::npos)
+        << e.what();
+  }
+  const SettledState resting = settle(deck(0.6), crit, true);
+  EXPECT_TRUE(resting.settled);
+  EXPECT_FALSE(resting.collapsed);
 }
 
 // A capacity run killed after some trials resumes from its journal: the finished trials are
