@@ -129,8 +129,7 @@ inline bool overlap_negligible(const std::array<Vec2, 3>& c, const std::array<Ve
   const double t2 = (tx[1] - tx[0]) * (ty[2] - ty[0]) - (ty[1] - ty[0]) * (tx[2] - tx[0]);
   // Twice the area below which an overlap is certainly discarded; 0 (only separation rejects)
   // for an inverted or degenerate triangle.
-  double cut = kNegligibleMargin * kMinOverlapFraction * std::min(c2, t2);
-  if (!(cut > 0.0)) cut = 0.0;
+  const double cut = kNegligibleMargin * kMinOverlapFraction * std::min(c2, t2);
   // Some edge line of A leaves on its side nothing of B, or a corner of B below the cut-off.
   auto beyond_an_edge = [cut](const double* ax, const double* ay, const double* bx,
                               const double* by, double b2) {
@@ -140,13 +139,19 @@ inline bool overlap_negligible(const std::array<Vec2, 3>& c, const std::array<Ve
       const double e0 = ex * (by[0] - ay[i]) - ey * (bx[0] - ax[i]);
       const double e1 = ex * (by[1] - ay[i]) - ey * (bx[1] - ax[i]);
       const double e2 = ex * (by[2] - ay[i]) - ey * (bx[2] - ax[i]);
-      const int inside = (e0 > 0.0) + (e1 > 0.0) + (e2 > 0.0);
-      if (inside == 0) return true;
-      if (inside == 1 && cut > 0.0) {
-        const double ev = e0 > 0.0 ? e0 : (e1 > 0.0 ? e1 : e2);
-        const double ea = e0 > 0.0 ? e1 : e0, eb = e2 > 0.0 ? e1 : e2;
-        if (b2 * ev * ev <= cut * (ev - ea) * (ev - eb)) return true;
+      if (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0) return true;
+      if (!(cut > 0.0)) continue;
+      double ev, ea, eb;  // exactly one vertex inside, or next line
+      if (e0 > 0.0) {
+        if (e1 > 0.0 || e2 > 0.0) continue;
+        ev = e0, ea = e1, eb = e2;
+      } else if (e1 > 0.0) {
+        if (e2 > 0.0) continue;
+        ev = e1, ea = e0, eb = e2;
+      } else {
+        ev = e2, ea = e0, eb = e1;
       }
+      if (b2 * ev * ev <= cut * (ev - ea) * (ev - eb)) return true;
     }
     return false;
   };
