@@ -81,6 +81,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "contact/broad_phase.hpp"
@@ -127,9 +128,10 @@ inline bool overlap_negligible(const std::array<Vec2, 3>& c, const std::array<Ve
   const double ty[3] = {t[0].y - oy, t[1].y - oy, t[2].y - oy};
   const double c2 = cx[1] * cy[2] - cy[1] * cx[2];  // twice the areas
   const double t2 = (tx[1] - tx[0]) * (ty[2] - ty[0]) - (ty[1] - ty[0]) * (tx[2] - tx[0]);
-  // Twice the area below which an overlap is certainly discarded; 0 (only separation rejects)
-  // for an inverted or degenerate triangle.
-  const double cut = kNegligibleMargin * kMinOverlapFraction * std::min(c2, t2);
+  // Twice the area below which an overlap is certainly discarded; NaN for an inverted or
+  // degenerate triangle (every comparison with it is false: only separation rejects).
+  double cut = kNegligibleMargin * kMinOverlapFraction * std::min(c2, t2);
+  if (!(cut > 0.0)) cut = std::numeric_limits<double>::quiet_NaN();
   // Some edge line of A leaves on its side nothing of B, or a corner of B below the cut-off.
   auto beyond_an_edge = [cut](const double* ax, const double* ay, const double* bx,
                               const double* by, double b2) {
@@ -140,7 +142,6 @@ inline bool overlap_negligible(const std::array<Vec2, 3>& c, const std::array<Ve
       const double e1 = ex * (by[1] - ay[i]) - ey * (bx[1] - ax[i]);
       const double e2 = ex * (by[2] - ay[i]) - ey * (bx[2] - ax[i]);
       if (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0) return true;
-      if (!(cut > 0.0)) continue;
       double ev, ea, eb;  // exactly one vertex inside, or next line
       if (e0 > 0.0) {
         if (e1 > 0.0 || e2 > 0.0) continue;
