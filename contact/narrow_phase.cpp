@@ -57,30 +57,34 @@ inline Bary barycentric(const Edges& t) {
 
 // Keeps the part of convex `in` where f >= 0 (Sutherland-Hodgman, one line of c), keeping
 // track of which triangle each edge lies on.
-inline void clip(const Poly& in, const Affine& f, Poly& out) {
-  out.n = 0;
+// kN: the vertex count when known at compile time (3: the first clip of t), else 0.
+template <int kN = 0>
+inline void clip(const Poly& __restrict in, const Affine& f, Poly& __restrict out) {
+  const int n = kN > 0 ? kN : in.n;
+  int m = 0;  // out.n, counted in a register
   double fv[kMaxPoly];
-  for (int k = 0; k < in.n; ++k) fv[k] = f(in.x[k], in.y[k]);
-  for (int q = 0, p = in.n - 1; q < in.n; p = q++) {
+  for (int k = 0; k < n; ++k) fv[k] = f(in.x[k], in.y[k]);
+  for (int q = 0, p = n - 1; q < n; p = q++) {
     const double fp = fv[p], fq = fv[q];
     if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
       const double s = fp / (fp - fq);
-      out.x[out.n] = in.x[p] + s * (in.x[q] - in.x[p]);
-      out.y[out.n] = in.y[p] + s * (in.y[q] - in.y[p]);
+      out.x[m] = in.x[p] + s * (in.x[q] - in.x[p]);
+      out.y[m] = in.y[p] + s * (in.y[q] - in.y[p]);
       // Leaving: the next edge runs along the clip line; entering: along the edge p -> q.
-      out.on_c[out.n] = fq < 0.0 ? 1 : in.on_c[p];
-      ++out.n;
+      out.on_c[m] = fq < 0.0 ? 1 : in.on_c[p];
+      ++m;
     }
     if (fq >= 0.0) {
-      out.x[out.n] = in.x[q];
-      out.y[out.n] = in.y[q];
+      out.x[m] = in.x[q];
+      out.y[m] = in.y[q];
       // Its outgoing edge is part of the input edge q -> r, unless q lies on the line and r
       // is outside: then no intersection follows and the edge runs along the clip line.
-      const int r = q + 1 < in.n ? q + 1 : 0;
-      out.on_c[out.n] = (fq == 0.0 && fv[r] < 0.0) ? 1 : in.on_c[q];
-      ++out.n;
+      const int r = q + 1 < n ? q + 1 : 0;
+      out.on_c[m] = (fq == 0.0 && fv[r] < 0.0) ? 1 : in.on_c[q];
+      ++m;
     }
   }
+  out.n = m;
 }
 
 // Area and first moments (int x dA, int y dA) of a polygon (counter-clockwise).
@@ -298,7 +302,7 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
     p0.y[k] = ty[k];
     p0.on_c[k] = 0;
   }
-  clip(p0, ec.e[0], p1);
+  clip<3>(p0, ec.e[0], p1);
   if (p1.n < 3) return out;
   clip(p1, ec.e[1], p0);
   if (p0.n < 3) return out;
