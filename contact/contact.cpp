@@ -99,8 +99,7 @@ struct ContactSystem::Impl {
   template <bool kFriction>
   bool evaluate(std::size_t p, const Nodes& n, double dt, PairResult& r);
   template <bool kFriction>
-  bool evaluate_overlap(std::size_t p, const std::array<Vec2, 3>& cv, const std::array<Vec2, 3>& tv,
-                        const Nodes& n, double dt, PairResult& r);
+  bool evaluate_overlap(std::size_t p, const Nodes& n, double dt, PairResult& r);
   template <bool kFriction>
   void accumulate(Model& model, double dt, EnergyLedger& ledger);
 };
@@ -344,18 +343,23 @@ inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double 
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
     return false;
   }
-  return evaluate_overlap<kFriction>(p, cv, tv, n, dt, r);
+  return evaluate_overlap<kFriction>(p, n, dt, r);
 }
 
 // The kernel and friction for a pair that passed the pre-tests. Kept out of line so that the
 // rejection path above (70 of the 82 pairs per step on the 48-triangle arch) runs without the
 // kernel's stack frame and register saves (callgrind: ~20 instructions per rejected pair).
 template <bool kFriction>
-[[gnu::noinline]] bool ContactSystem::Impl::evaluate_overlap(std::size_t p,
-                                                             const std::array<Vec2, 3>& cv,
-                                                             const std::array<Vec2, 3>& tv,
-                                                             const Nodes& n, double dt,
-                                                             PairResult& r) {
+[[gnu::noinline]] bool ContactSystem::Impl::evaluate_overlap(std::size_t p, const Nodes& n,
+                                                             double dt, PairResult& r) {
+  // The positions again (12 loads, for the few overlapping pairs): the rejection path keeps
+  // them in registers instead of storing them for this call.
+  const double* x = n.x.data();
+  const double* y = n.y.data();
+  const std::array<Vec2, 3> cv{Vec2{x[pc0[p]], y[pc0[p]]}, Vec2{x[pc1[p]], y[pc1[p]]},
+                               Vec2{x[pc2[p]], y[pc2[p]]}};
+  const std::array<Vec2, 3> tv{Vec2{x[pt0[p]], y[pt0[p]]}, Vec2{x[pt1[p]], y[pt1[p]]},
+                               Vec2{x[pt2[p]], y[pt2[p]]}};
   const PairForce f = triangle_pair_force(cv, tv, penalty * thickness);
   if (!(f.area > 0.0)) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;
