@@ -57,30 +57,34 @@ inline Bary barycentric(const Edges& t) {
 
 // Keeps the part of convex `in` where f >= 0 (Sutherland-Hodgman, one line of c), keeping
 // track of which triangle each edge lies on.
-inline void clip(const Poly& in, const Affine& f, Poly& out) {
-  out.n = 0;
+// kN: the vertex count when known at compile time (3: the first clip of t), else 0.
+template <int kN = 0>
+inline void clip(const Poly& __restrict in, const Affine& f, Poly& __restrict out) {
+  const int n = kN > 0 ? kN : in.n;
+  int m = 0;  // out.n, counted in a register
   double fv[kMaxPoly];
-  for (int k = 0; k < in.n; ++k) fv[k] = f(in.x[k], in.y[k]);
-  for (int q = 0, p = in.n - 1; q < in.n; p = q++) {
+  for (int k = 0; k < n; ++k) fv[k] = f(in.x[k], in.y[k]);
+  for (int q = 0, p = n - 1; q < n; p = q++) {
     const double fp = fv[p], fq = fv[q];
     if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
       const double s = fp / (fp - fq);
-      out.x[out.n] = in.x[p] + s * (in.x[q] - in.x[p]);
-      out.y[out.n] = in.y[p] + s * (in.y[q] - in.y[p]);
+      out.x[m] = in.x[p] + s * (in.x[q] - in.x[p]);
+      out.y[m] = in.y[p] + s * (in.y[q] - in.y[p]);
       // Leaving: the next edge runs along the clip line; entering: along the edge p -> q.
-      out.on_c[out.n] = fq < 0.0 ? 1 : in.on_c[p];
-      ++out.n;
+      out.on_c[m] = fq < 0.0 ? 1 : in.on_c[p];
+      ++m;
     }
     if (fq >= 0.0) {
-      out.x[out.n] = in.x[q];
-      out.y[out.n] = in.y[q];
+      out.x[m] = in.x[q];
+      out.y[m] = in.y[q];
       // Its outgoing edge is part of the input edge q -> r, unless q lies on the line and r
       // is outside: then no intersection follows and the edge runs along the clip line.
-      const int r = q + 1 < in.n ? q + 1 : 0;
-      out.on_c[out.n] = (fq == 0.0 && fv[r] < 0.0) ? 1 : in.on_c[q];
-      ++out.n;
+      const int r = q + 1 < n ? q + 1 : 0;
+      out.on_c[m] = (fq == 0.0 && fv[r] < 0.0) ? 1 : in.on_c[q];
+      ++m;
     }
   }
+  out.n = m;
 }
 
 // Area and first moments (int x dA, int y dA) of a polygon (counter-clockwise).
@@ -189,7 +193,7 @@ inline PhiReference phi_reference(const Bary& T, const double* px, const double*
   const Affine& lm = T.lam[m];
   // Which other sub-triangles P reaches into (P convex: none of R_k when lambda_k is not below
   // lambda_m, or not below lambda_j, at any vertex of P).
-  const int k1 = (m + 1) % 3, k2 = (m + 2) % 3;
+  const int k1 = m == 2 ? 0 : m + 1, k2 = m == 0 ? 2 : m - 1;
   bool k1_above_m = true, k1_above_k2 = true, k2_above_m = true, k2_above_k1 = true;
   for (int v = 0; v < P.n; ++v) {
     const double am = lm(P.x[v], P.y[v]), a1 = T.lam[k1](P.x[v], P.y[v]),
@@ -203,30 +207,27 @@ inline PhiReference phi_reference(const Bary& T, const double* px, const double*
   reaches[k1] = !(k1_above_m || k1_above_k2);
   reaches[k2] = !(k2_above_m || k2_above_k1);
   PhiReference r;
-  int skip = m;  // the corner term that vanishes at X besides m's
-  if (reaches[k1] || reaches[k2]) {
-    // P reaches a corner of T: X = the vertex where edge m meets the edge of a sub-triangle P
-    // reaches (lambda_m = lambda_k = 0 there), so only a third sub-triangle needs its piece.
-    const int k = reaches[k1] ? k1 : k2;
-    const int v = 3 - m - k;  // the vertex opposite the third edge: on edges m and k
-    r.x = px[v];
-    r.y = py[v];
-    skip = k;
-  } else {
+  if (!(reaches[k1] || reaches[k2])) {
     // Within R_m: X = the centroid projected onto edge line m (lambda_m(X) = 0).
     const double s = (m == 0 ? l0 : (m == 1 ? l1 : l2)) / (lm.b * lm.b + lm.c * lm.c);
     r.x = cx - s * lm.b;
     r.y = cy - s * lm.c;
     return r;
   }
-  for (int k = 0; k < 3; ++k) {
-    if (k == m || k == skip || !reaches[k]) continue;
-    const Affine& lk = T.lam[k];
-    const Affine& lj = T.lam[3 - m - k];
+  // P reaches a corner of T: X = the vertex where edge m meets the edge of a sub-triangle P
+  // reaches (lambda_m = lambda_k = 0 there), so only the third sub-triangle, if P reaches it
+  // as well, needs its piece.
+  const int k = reaches[k1] ? k1 : k2;
+  const int third = 3 - m - k;  // also the vertex opposite it: on edges m and k
+  r.x = px[third];
+  r.y = py[third];
+  if (reaches[third]) {
+    const Affine& lk = T.lam[third];
+    const Affine& lj = T.lam[k];
     Poly half, piece;
     clip(P, {lm.a - lk.a, lm.b - lk.b, lm.c - lk.c}, half);  // lambda_m >= lambda_k
     clip(half, {lj.a - lk.a, lj.b - lk.b, lj.c - lk.c}, piece);
-    r.corners += 3.0 * lk(r.x, r.y) * moments(piece).area;
+    r.corners = 3.0 * lk(r.x, r.y) * moments(piece).area;
   }
   return r;
 }
@@ -290,7 +291,8 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   }
   const Edges ec = edge_functions(cx, cy);
   const double t_twice_area = (tx[1] - tx[0]) * (ty[2] - ty[0]) - (ty[1] - ty[0]) * (tx[2] - tx[0]);
-  if (!(ec.twice_area > 0.0) || !(t_twice_area > 0.0)) return {};
+  PairForce out;  // zero until the overlap is known (one returned object: no copy)
+  if (!(ec.twice_area > 0.0) || !(t_twice_area > 0.0)) return out;
 
   // Overlap P = t clipped by the three edges of c (no division before we know it is there).
   Poly p0, p1;
@@ -300,17 +302,16 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
     p0.y[k] = ty[k];
     p0.on_c[k] = 0;
   }
-  clip(p0, ec.e[0], p1);
-  if (p1.n < 3) return {};
+  clip<3>(p0, ec.e[0], p1);
+  if (p1.n < 3) return out;
   clip(p1, ec.e[1], p0);
-  if (p0.n < 3) return {};
+  if (p0.n < 3) return out;
   clip(p0, ec.e[2], p1);
   const Poly& P = p1;
-  if (P.n < 3) return {};
+  if (P.n < 3) return out;
   const Moments mp = moments(P);
-  if (!(mp.area > kMinOverlapFraction * 0.5 * std::min(ec.twice_area, t_twice_area))) return {};
+  if (!(mp.area > kMinOverlapFraction * 0.5 * std::min(ec.twice_area, t_twice_area))) return out;
 
-  PairForce out;
   const Edges et = edge_functions(tx, ty);
   const Bary bc = barycentric(ec), bt = barycentric(et);
   const double c0x = mp.sx / mp.area, c0y = mp.sy / mp.area;  // overlap centroid

@@ -1,7 +1,8 @@
 // Speed-pass checks that could fail: the METIS locality ordering (core/ordering.hpp) must
 // change nothing but the numbering; the separating-axis pre-test the contact stage runs before
-// the narrow-phase kernel (contact/narrow_phase.hpp triangles_separated) may only reject pairs
-// whose kernel result is zero, and it must actually reject the pairs that are apart.
+// the narrow-phase kernel (contact/narrow_phase.hpp overlap_negligible) may only reject pairs
+// whose kernel result is zero, and it must actually reject the pairs that are apart and the
+// corner touches across a joint.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -40,7 +41,7 @@ TEST(Speed, SeparatingAxisRejectsOnlyPairsWithoutContact) {
     const auto c = random_triangle(rng, {0.0, 0.0}, 1.0);
     const auto t = random_triangle(rng, {offset(rng), offset(rng)}, 1.0);
     const PairForce f = triangle_pair_force(c, t, 1e9);
-    const bool sep = triangles_separated(c, t);
+    const bool sep = overlap_negligible(c, t);
     if (sep) {
       ++separated;
       EXPECT_EQ(f.area, 0.0) << "pair " << k;
@@ -68,10 +69,65 @@ TEST(Speed, SeparatingAxisOnSharedEdgeAndVertex) {
   const std::array<Vec2, 3> shared_edge{Vec2{1.0, 0.0}, Vec2{1.0, 1.0}, Vec2{0.0, 1.0}};
   const std::array<Vec2, 3> shared_vertex{Vec2{1.0, 0.0}, Vec2{2.0, 0.0}, Vec2{2.0, 1.0}};
   const std::array<Vec2, 3> overlapping{Vec2{0.2, 0.2}, Vec2{1.2, 0.2}, Vec2{0.2, 1.2}};
-  EXPECT_TRUE(triangles_separated(c, shared_edge));
-  EXPECT_TRUE(triangles_separated(c, shared_vertex));
-  EXPECT_FALSE(triangles_separated(c, overlapping));
+  EXPECT_TRUE(overlap_negligible(c, shared_edge));
+  EXPECT_TRUE(overlap_negligible(c, shared_vertex));
+  EXPECT_FALSE(overlap_negligible(c, overlapping));
   EXPECT_GT(triangle_pair_force(c, overlapping, 1e9).area, 0.0);
+}
+
+// Pairs across a joint, as in a settled arch: c above the joint line with a face on it, t
+// below with a face (face to face) or only a vertex (corner neighbour) on it, the blocks
+// pressed together by a depth d from 1e-14 to 1e-2 of the size, the joint's ends often shared,
+// the whole scene rotated and shifted. overlap_negligible must never reject a pair the kernel
+// gives an overlap for, and must reject most corner touches the kernel discards.
+TEST(Speed, NegligibleOverlapRejectsOnlyDiscardedCornerTouches) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int kernel_zero = 0, rejected = 0, touching = 0;
+  for (int k = 0; k < 40000; ++k) {
+    const double size = std::pow(10.0, -2.0 + 3.0 * u(rng));  // 0.01 to 10 m
+    const double d = size * std::pow(10.0, -14.0 + 12.0 * u(rng));
+    auto along = [&] { return size * (2.0 * u(rng) - 1.0); };
+    double a0 = along(), a1 = along();
+    if (a1 < a0) std::swap(a0, a1);
+    if (a1 - a0 < 0.05 * size) continue;
+    // c: face (a0, a1) on y = -d (pressed down into t), apex above.
+    std::array<Vec2, 3> c{Vec2{a0, -d}, Vec2{a1, -d}, Vec2{along(), size * (0.2 + u(rng))}};
+    // t: a vertex at a joint end or anywhere on y = 0, the rest below (or a second on y = 0).
+    const double pick = u(rng);
+    const double b0 = pick < 0.3 ? a0 : (pick < 0.6 ? a1 : along());
+    std::array<Vec2, 3> t;
+    if (u(rng) < 0.5) {  // corner neighbour: one vertex on the joint line
+      t = {Vec2{b0, 0.0}, Vec2{along(), -size * (0.2 + u(rng))},
+           Vec2{along(), -size * (0.2 + u(rng))}};
+    } else {  // face on the joint line
+      t = {Vec2{b0, 0.0}, Vec2{along(), 0.0}, Vec2{along(), -size * (0.2 + u(rng))}};
+    }
+    auto twice_area = [](const std::array<Vec2, 3>& p) {
+      return (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+    };
+    if (twice_area(t) < 0.0) std::swap(t[1], t[2]);
+    if (std::abs(twice_area(t)) < 1e-3 * size * size) continue;
+    // Rotate and shift the scene (the arch's joints lie at every angle, far from the origin).
+    const double th = 6.283185307179586 * u(rng), co = std::cos(th), si = std::sin(th);
+    const Vec2 shift{10.0 * along(), 10.0 * along()};
+    for (auto* p : {&c, &t})
+      for (Vec2& v : *p) v = {shift.x + co * v.x - si * v.y, shift.y + si * v.x + co * v.y};
+    const PairForce f = triangle_pair_force(c, t, 1e9);
+    const bool reject = overlap_negligible(c, t);
+    if (reject) {
+      ++rejected;
+      EXPECT_EQ(f.area, 0.0) << "pair " << k << " depth " << d << " size " << size;
+      EXPECT_EQ(f.energy, 0.0) << "pair " << k;
+    }
+    if (f.area > 0.0)
+      ++touching;
+    else
+      ++kernel_zero;
+  }
+  std::printf("rejected %d, kernel zero %d, touching %d\n", rejected, kernel_zero, touching);
+  EXPECT_GT(touching, 5000);
+  EXPECT_GT(rejected, kernel_zero * 9 / 10);
 }
 
 // order_for_locality renumbers nodes and triangles inside blocks and nothing else: block
