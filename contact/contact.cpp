@@ -468,7 +468,9 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
     const double* sfy = slot_fy.data();
 #pragma omp parallel
     {
-#pragma omp for schedule(static)
+      // Touching pairs cluster in the pair list (sorted by triangle id): chunks of 256 pairs
+      // dealt round-robin balance the threads (one half each gave 62% of the work to one).
+#pragma omp for schedule(static, 256)
       for (std::int64_t p = 0; p < count; ++p) {
         PairResult r;
         store(p, evaluate<kFriction>(p, n, dt, r) ? &r : nullptr);
