@@ -66,10 +66,12 @@ constexpr std::size_t kParallelPairs = 8192;
 constexpr int kPairSlots = 6;
 
 // What one pair adds: nodal forces (potential + friction), stored and dissipated energy.
+// Pure output of evaluate (every field written when the pair touches), so not initialised.
 struct PairResult {
-  Vec2 on_c[3], on_t[3];
-  double energy = 0.0, stored = 0.0, dissipated = 0.0;
-  bool active = false;
+  double energy, stored, dissipated;
+  struct {
+    double x, y;
+  } on_c[3], on_t[3];
 };
 
 }  // namespace
@@ -405,8 +407,8 @@ inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double 
   r.stored = 0.0;
   r.dissipated = 0.0;
   for (int k = 0; k < 3; ++k) {
-    r.on_c[k] = f.on_c[k];
-    r.on_t[k] = f.on_t[k];
+    r.on_c[k] = {f.on_c[k].x, f.on_c[k].y};
+    r.on_t[k] = {f.on_t[k].x, f.on_t[k].y};
   }
   if constexpr (kFriction) {
     const double* vx = n.vx.data();

@@ -56,8 +56,10 @@ inline void gather_node_slots(const NodeSlots& s, std::int64_t k, const double* 
   const Index* __restrict slot = s.slot.data();
   const Index i = s.node[k], j0 = s.begin[k], j1 = s.begin[k + 1];
   double x = fx[i], y = fy[i];
-  for (Index j = j0; j < j1; ++j) x += sfx[slot[j]];
-  for (Index j = j0; j < j1; ++j) y += sfy[slot[j]];
+  for (Index j = j0; j < j1; ++j) {
+    const Index at = slot[j];
+    x += sfx[at], y += sfy[at];
+  }
   fx[i] = x, fy[i] = y;
 }
 
