@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "core/parallel.hpp"
+
 namespace voussoir {
 
 namespace {
@@ -103,11 +105,22 @@ bool BroadPhase::needs_detection(const Nodes& nodes) const {
   const Index* id = parts_.free_nodes.data();
   const double *x = nodes.x.data(), *y = nodes.y.data();
   const double *rx = ref_x_.data(), *ry = ref_y_.data();
+  if (m < kParallelNodes || !threads_available()) {
+    for (Index k = 0; k < m; ++k) {
+      const double dx = x[id[k]] - rx[k], dy = y[id[k]] - ry[k];
+      if (dx * dx + dy * dy > limit2) return true;
+    }
+    return false;
+  }
+  // Large models, every step: the nodes on the threads (a yes/no answer, the same for any
+  // split; no early exit, detection is rare).
+  bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved)
   for (Index k = 0; k < m; ++k) {
     const double dx = x[id[k]] - rx[k], dy = y[id[k]] - ry[k];
-    if (dx * dx + dy * dy > limit2) return true;
+    moved = moved | (dx * dx + dy * dy > limit2);
   }
-  return false;
+  return moved;
 }
 
 void BroadPhase::compute_boxes(const Nodes& nodes) {

@@ -1,10 +1,14 @@
 // Contact stage: NBS broad phase (lazy), potential penalty narrow phase, Coulomb friction.
 //
-// Threads. With OpenMP and at least kParallelPairs candidates, pairs are evaluated in parallel
-// (each pair owns its friction state), their results stored per pair and added to the nodes
-// serially in pair order, so forces and energies are bit-identical for any thread count
-// (no atomics, no per-thread force arrays). Below that size, or inside an enclosing parallel
-// region (parallel sweeps), one thread does both in the same order.
+// Threads. With OpenMP and at least kParallelPairs candidates, one parallel region per step:
+// pairs are evaluated in parallel (each pair owns its friction state) and write their corner
+// forces to their own slots (core/node_slots.hpp: -0.0 for a pair that does not touch); after
+// one barrier each node sums its slots in ascending pair order (node -> slot CSR built at the
+// first threaded step after a detection), which is the sequence of additions of the
+// one-thread loop, while one thread sums the energies of the touching pairs in pair order.
+// So forces and energies are bit-identical to the one-thread loop for any thread count (no
+// atomics, no per-thread force arrays). Below that size, or inside an enclosing parallel region
+// (parallel sweeps), one thread evaluates and adds each pair in turn.
 //
 // Stable time step contribution (max_omega_squared). Model: a boundary edge k of length L
 // pressed flat into a partner face by a depth d. The overlap is a strip of area L d lying in
@@ -33,8 +37,6 @@
 
 #include "contact/contact.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -45,6 +47,8 @@
 #include "contact/broad_phase.hpp"
 #include "contact/friction.hpp"
 #include "contact/narrow_phase.hpp"
+#include "core/node_slots.hpp"
+#include "core/parallel.hpp"
 
 namespace voussoir {
 
@@ -57,11 +61,17 @@ namespace {
 // threads than on one on the loaded 2-core machine. Parallel pairs pay only on large scenes.
 constexpr std::size_t kParallelPairs = 8192;
 
+// Corner slots per pair on the threaded path: [6 p + 2 k + side], side 0 for corner k of the
+// pair's first triangle c, 1 for the second t (the order in which the one-thread loop adds them).
+constexpr int kPairSlots = 6;
+
 // What one pair adds: nodal forces (potential + friction), stored and dissipated energy.
+// Pure output of evaluate (every field written when the pair touches), so not initialised.
 struct PairResult {
-  Vec2 on_c[3], on_t[3];
-  double energy = 0.0, stored = 0.0, dissipated = 0.0;
-  bool active = false;
+  double energy, stored, dissipated;
+  struct {
+    double x, y;
+  } on_c[3], on_t[3];
 };
 
 }  // namespace
@@ -91,10 +101,18 @@ struct ContactSystem::Impl {
   // the broad phase's reference, kept here for save_state (its copy is private).
   std::vector<double> detected_x, detected_y;
 
-  std::vector<PairResult> results;  // per-pair slots of the multi-threaded path
+  // Threaded path (parallel_pairs candidates and up; a test may lower it).
+  std::size_t parallel_pairs = kParallelPairs;
+  std::vector<double> slot_fx, slot_fy;      // [kPairSlots p + 2 k + side] [N]
+  std::vector<double> pair_sums;             // [3 p ..]: energy, stored, dissipated [J]
+  std::vector<unsigned char> pair_touching;  // 1 when pair p touches
+  NodeSlots node_slots;                      // per node its slots, in ascending pair order
+  bool slots_built = false;                  // node_slots is that of the current pairs
 
   void index_pairs(const Model& model);
   void record_detection(const Nodes& nodes);
+  void build_slots(Index node_count);
+  void store(std::size_t p, const PairResult* r);
 
   template <bool kFriction>
   bool evaluate(std::size_t p, const Nodes& n, double dt, PairResult& r);
@@ -186,6 +204,46 @@ void ContactSystem::Impl::index_pairs(const Model& model) {
     pt0[p] = t.n0[b], pt1[p] = t.n1[b], pt2[p] = t.n2[b];
     kt[p] = scale * (3.0 / height[a] + 3.0 / height[b]) * std::min(edge_len[a], edge_len[b]);
   }
+  slots_built = false;
+}
+
+// Slot buffers and the node -> slot CSR of the threaded path for the current pairs.
+void ContactSystem::Impl::build_slots(Index node_count) {
+  const std::size_t np = pairs.size();
+  slot_fx.resize(kPairSlots * np);
+  slot_fy.resize(kPairSlots * np);
+  pair_sums.resize(3 * np);
+  pair_touching.resize(np);
+  build_node_slots(
+      node_count,
+      [this, np](auto&& add) {
+        for (std::size_t p = 0; p < np; ++p) {
+          const Index c[3] = {pc0[p], pc1[p], pc2[p]};
+          const Index d[3] = {pt0[p], pt1[p], pt2[p]};
+          const Index first = Index(kPairSlots * p);
+          for (int k = 0; k < 3; ++k) add(c[k], first + 2 * k), add(d[k], first + 2 * k + 1);
+        }
+      },
+      node_slots);
+  slots_built = true;
+}
+
+// Writes pair p's result (or, for r == nullptr, a pair that does not touch: -0.0, which adds
+// nothing) to its slots.
+void ContactSystem::Impl::store(std::size_t p, const PairResult* r) {
+  double* fx = slot_fx.data() + kPairSlots * p;
+  double* fy = slot_fy.data() + kPairSlots * p;
+  double* sums = pair_sums.data() + 3 * p;
+  pair_touching[p] = r != nullptr;
+  if (r == nullptr) {
+    for (int j = 0; j < kPairSlots; ++j) fx[j] = fy[j] = -0.0;
+    return;
+  }
+  for (int k = 0; k < 3; ++k) {
+    fx[2 * k] = r->on_c[k].x, fy[2 * k] = r->on_c[k].y;
+    fx[2 * k + 1] = r->on_t[k].x, fy[2 * k + 1] = r->on_t[k].y;
+  }
+  sums[0] = r->energy, sums[1] = r->stored, sums[2] = r->dissipated;
 }
 
 void ContactSystem::Impl::record_detection(const Nodes& nodes) {
@@ -369,8 +427,8 @@ template <bool kFriction>
   r.stored = 0.0;
   r.dissipated = 0.0;
   for (int k = 0; k < 3; ++k) {
-    r.on_c[k] = f.on_c[k];
-    r.on_t[k] = f.on_t[k];
+    r.on_c[k] = {f.on_c[k].x, f.on_c[k].y};
+    r.on_t[k] = {f.on_t[k].x, f.on_t[k].y};
   }
   if constexpr (kFriction) {
     const double* vx = n.vx.data();
@@ -423,16 +481,37 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
     }
   };
   const std::size_t np = pairs.size();
-  if (np >= kParallelPairs && omp_get_max_threads() > 1 && !omp_in_parallel()) {
-    // Pairs are independent (each owns its friction state); results go to per-pair slots
-    // and are added serially in pair order: bit-identical to the one-thread path.
-    results.resize(np);
+  if (np >= parallel_pairs && threads_available()) {
+    // Pairs are independent (each owns its friction state) and write their own slots; then
+    // each node adds its slots in pair order and one thread the energies in pair order:
+    // the additions of the one-thread path, so bit-identical to it.
+    if (!slots_built) build_slots(n.size());
     const std::int64_t count = static_cast<std::int64_t>(np);
-#pragma omp parallel for schedule(static)
-    for (std::int64_t p = 0; p < count; ++p)
-      results[p].active = evaluate<kFriction>(p, n, dt, results[p]);
-    for (std::size_t p = 0; p < np; ++p)
-      if (results[p].active) apply(p, results[p]);
+    const std::int64_t nodes = gathered_nodes(node_slots);
+    const double* sfx = slot_fx.data();
+    const double* sfy = slot_fy.data();
+#pragma omp parallel
+    {
+      // Touching pairs cluster in the pair list (sorted by triangle id): chunks of 256 pairs
+      // dealt round-robin balance the threads (one half each gave 62% of the work to one).
+#pragma omp for schedule(static, 256)
+      for (std::int64_t p = 0; p < count; ++p) {
+        PairResult r;
+        store(p, evaluate<kFriction>(p, n, dt, r) ? &r : nullptr);
+      }
+      // Static split: the work per thread is a function of the model (reproducible counts in
+      // callgrind); the first thread done with its share sums the energies.
+#pragma omp for schedule(static) nowait
+      for (std::int64_t k = 0; k < nodes; ++k) gather_node_slots(node_slots, k, sfx, sfy, fx, fy);
+#pragma omp single nowait
+      for (std::size_t p = 0; p < np; ++p) {
+        if (!pair_touching[p]) continue;
+        ++n_active;
+        energy += pair_sums[3 * p];
+        stored += pair_sums[3 * p + 1];
+        dissipated += pair_sums[3 * p + 2];
+      }
+    }
   } else {
     PairResult r;
     for (std::size_t p = 0; p < np; ++p)
@@ -512,6 +591,10 @@ double ContactSystem::max_omega_squared(const Model& model) const {
     w2 = std::max(w2, (mean + dev) * n.inv_mass[i]);
   }
   return w2;
+}
+
+void ContactSystem::set_parallel_pairs(std::int64_t min_pairs) {
+  impl_->parallel_pairs = std::size_t(std::max<std::int64_t>(min_pairs, 0));
 }
 
 std::int64_t ContactSystem::candidate_pairs() const {

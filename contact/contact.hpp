@@ -43,6 +43,10 @@ class ContactSystem {
   // omega_max^2 estimate [1/s2].
   double max_omega_squared(const Model& model) const;
 
+  // Candidate pairs from which add_forces runs on threads (default 8192, contact/contact.cpp
+  // kParallelPairs): tests lower it to run the threaded path on small scenes.
+  void set_parallel_pairs(std::int64_t min_pairs);
+
   std::int64_t candidate_pairs() const;
   std::int64_t active_pairs() const;  // pairs with nonzero overlap at the last add_forces
   std::int64_t detections() const;

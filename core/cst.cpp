@@ -2,12 +2,13 @@
 
 #include "core/cst.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include "core/node_slots.hpp"
+#include "core/parallel.hpp"
 
 namespace voussoir {
 
@@ -25,7 +26,7 @@ namespace {
 // alike. The threaded path runs the same chunks (same function, so the same code and the same
 // order of the in-chunk sums) on the threads, each chunk writing its corner forces to its own
 // slots of ElementWorkspace::corner_fx/fy; then each node sums its corner slots in ascending
-// triangle order (CSR node_begin/node_corner). That is exactly the sequence of additions the
+// triangle order (core/node_slots.hpp). That is exactly the sequence of additions the
 // scatter makes into fx[i], and the chunk sums are added in chunk order: every force and
 // energy is bit-identical to the one-thread loop for any thread count, with no atomics.
 // Rejected: colouring (a different addition order from the one-thread loop, so the small
@@ -37,10 +38,6 @@ namespace {
 // kParallelPairs); 8192 triangles are ~150 us of one-thread work.
 constexpr Index kParallelTriangles = 8192;
 constexpr int kChunk = kElementChunk;
-
-bool threads_available() {
-  return omp_get_max_threads() > 1 && !omp_in_parallel();
-}
 
 // Hot arrays of the element stage as flat pointers (STYLE.md "Hot loops").
 struct ElementArrays {
@@ -181,25 +178,19 @@ void build_workspace(const Model& model, ElementWorkspace& w) {
   w.corner_fx.assign(slots, 0.0);
   w.corner_fy.assign(slots, 0.0);
   w.chunk_sums.assign(3 * chunks, 0.0);
-  const Index nn = model.nodes.size();
   const Triangles& t = model.tris;
-  w.node_begin.assign(std::size_t(nn) + 1, 0);
-  for (std::size_t k = 0; k < chunks; ++k)
-    for (int j = 0; j < w.chunk_len[k]; ++j) {
-      const Index e = w.chunk_first[k] + j;
-      ++w.node_begin[t.n0[e] + 1], ++w.node_begin[t.n1[e] + 1], ++w.node_begin[t.n2[e] + 1];
-    }
-  for (Index i = 0; i < nn; ++i) w.node_begin[i + 1] += w.node_begin[i];
-  w.node_corner.assign(std::size_t(w.node_begin[nn]), 0);
-  std::vector<Index> fill(w.node_begin.begin(), w.node_begin.end() - 1);
-  for (std::size_t k = 0; k < chunks; ++k)  // ascending triangle order within each node
-    for (int j = 0; j < w.chunk_len[k]; ++j) {
-      const Index e = w.chunk_first[k] + j, slot = Index(k * 3 * kChunk) + j;
-      const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
-      for (int c = 0; c < 3; ++c) w.node_corner[fill[v[c]]++] = slot + c * kChunk;
-    }
+  build_node_slots(
+      model.nodes.size(),
+      [&w, &t, chunks](auto&& add) {
+        for (std::size_t k = 0; k < chunks; ++k)  // ascending triangle order
+          for (int j = 0; j < w.chunk_len[k]; ++j) {
+            const Index e = w.chunk_first[k] + j, slot = Index(k * 3 * kChunk) + j;
+            add(t.n0[e], slot), add(t.n1[e], slot + kChunk), add(t.n2[e], slot + 2 * kChunk);
+          }
+      },
+      w.slots);
   w.built_tris = t.size();
-  w.built_nodes = nn;
+  w.built_nodes = model.nodes.size();
 }
 
 // The threaded element stage: chunks on the threads, then the per-node gather.
@@ -210,12 +201,10 @@ ElementStageResult element_threads(Model& model, const CstLaw& law, double* visc
   double* __restrict fx = model.nodes.fx.data();
   double* __restrict fy = model.nodes.fy.data();
   const std::int64_t chunks = std::int64_t(w.chunk_first.size());
-  const Index nn = model.nodes.size();
+  const std::int64_t nodes = gathered_nodes(w.slots);
   double* corner_fx = w.corner_fx.data();
   double* corner_fy = w.corner_fy.data();
   double* sums = w.chunk_sums.data();
-  const Index* __restrict begin = w.node_begin.data();
-  const Index* __restrict corner = w.node_corner.data();
 #pragma omp parallel
   {
 #pragma omp for schedule(static)
@@ -226,12 +215,8 @@ ElementStageResult element_threads(Model& model, const CstLaw& law, double* visc
       sums[3 * k] = c.energy, sums[3 * k + 1] = c.power, sums[3 * k + 2] = c.previous_power;
     }
 #pragma omp for schedule(static)
-    for (Index i = 0; i < nn; ++i) {  // gather, in the scatter's order
-      double sx = fx[i], sy = fy[i];
-      for (Index s = begin[i]; s < begin[i + 1]; ++s) sx += corner_fx[corner[s]];
-      for (Index s = begin[i]; s < begin[i + 1]; ++s) sy += corner_fy[corner[s]];
-      fx[i] = sx, fy[i] = sy;
-    }
+    for (std::int64_t k = 0; k < nodes; ++k)  // gather, in the scatter's order
+      gather_node_slots(w.slots, k, corner_fx, corner_fy, fx, fy);
   }
   ChunkSums sum;
   for (std::int64_t k = 0; k < chunks; ++k)

@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "core/model.hpp"
+#include "core/node_slots.hpp"
 
 namespace voussoir {
 
@@ -304,15 +305,14 @@ constexpr int kElementChunk = 32;
 //     the one-thread loop (runs of contiguous free blocks, kElementChunk triangles at a time);
 //   corner_fx/fy[k * 3 kElementChunk + a kElementChunk + j]: force on corner a of triangle
 //     chunk_first[k] + j (the chunk buffer layout of the kernel);
-//   node_begin / node_corner (CSR, size nodes + 1 / corners of free triangles): the corner
-//     slots of node i, in ascending triangle order, i.e. the order in which the one-thread loop
-//     adds them into fx[i];
+//   slots (core/node_slots.hpp): per node of a free triangle its corner slots, in ascending
+//     triangle order, i.e. the order in which the one-thread loop adds them into fx[i];
 //   chunk_sums[3 k ..]: energy, damping power, previous damping power of chunk k.
 struct ElementWorkspace {
   std::vector<Index> chunk_first;
   std::vector<int> chunk_len;
   std::vector<double> corner_fx, corner_fy;
-  std::vector<Index> node_begin, node_corner;
+  NodeSlots slots;
   std::vector<double> chunk_sums;
   Index built_tris = -1, built_nodes = -1;
 };

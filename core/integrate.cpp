@@ -9,28 +9,15 @@
 
 #include "core/integrate.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <vector>
 
+#include "core/parallel.hpp"
+
 namespace voussoir {
 
 namespace {
-
-// Free nodes from which the chunked (and threaded) path is taken; same scale as the element
-// stage's kParallelTriangles (core/cst.cpp).
-constexpr Index kParallelNodes = 8192;
-constexpr Index kNodeChunk = 2048;
-
-bool threads_available() {
-  return omp_get_max_threads() > 1 && !omp_in_parallel();
-}
-
-struct NodeRange {
-  Index begin, end;
-};
 
 // Hot node arrays (STYLE.md "Hot loops").
 struct NodeArrays {
@@ -66,30 +53,6 @@ inline void update_nodes(const NodeArrays& a, double dt, Index begin, Index end,
     y[i] += dt * uy;
   }
   twice_kinetic = k2;
-}
-
-// Free node ranges (contiguous free blocks merged), cut into pieces of at most kNodeChunk.
-std::vector<NodeRange> free_node_chunks(const Model& model) {
-  std::vector<NodeRange> runs;
-  for (const Block& b : model.blocks) {
-    if (b.fixed || b.node_count == 0) continue;
-    if (!runs.empty() && runs.back().end == b.first_node)
-      runs.back().end += b.node_count;
-    else
-      runs.push_back({b.first_node, b.first_node + b.node_count});
-  }
-  std::vector<NodeRange> chunks;
-  for (const NodeRange& r : runs)
-    for (Index i = r.begin; i < r.end; i += kNodeChunk)
-      chunks.push_back({i, std::min(r.end, i + kNodeChunk)});
-  return chunks;
-}
-
-Index free_node_count(const Model& model) {
-  Index n = 0;
-  for (const Block& b : model.blocks)
-    if (!b.fixed) n += b.node_count;
-  return n;
 }
 
 }  // namespace

@@ -147,18 +147,29 @@ double min_triangle_height(const Model& model) {
   return h;
 }
 
-double free_area(const Model& model) {
-  double a = 0.0;
+namespace {
+
+// Sum of field(b) over the free blocks b, in block order.
+template <class T, class F>
+T sum_over_free_blocks(const Model& model, F field) {
+  T sum{};
   for (const Block& b : model.blocks)
-    if (!b.fixed) a += b.area;
-  return a;
+    if (!b.fixed) sum += field(b);
+  return sum;
+}
+
+}  // namespace
+
+double free_area(const Model& model) {
+  return sum_over_free_blocks<double>(model, [](const Block& b) { return b.area; });
 }
 
 double free_mass(const Model& model) {
-  double m = 0.0;
-  for (const Block& b : model.blocks)
-    if (!b.fixed) m += b.mass;
-  return m;
+  return sum_over_free_blocks<double>(model, [](const Block& b) { return b.mass; });
+}
+
+Index free_node_count(const Model& model) {
+  return sum_over_free_blocks<Index>(model, [](const Block& b) { return b.node_count; });
 }
 
 }  // namespace voussoir

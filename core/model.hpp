@@ -119,5 +119,6 @@ double min_triangle_height(const Model& model);
 // Sum of reference areas and masses over blocks that are not fixed.
 double free_area(const Model& model);
 double free_mass(const Model& model);
+Index free_node_count(const Model& model);  // nodes of the free blocks
 
 }  // namespace voussoir
