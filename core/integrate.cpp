@@ -72,24 +72,10 @@ void clear_forces(Nodes& nodes) {
 
 double integrate_central_difference(Model& model, double dt) {
   const NodeArrays a = arrays_of(model.nodes);
-  double twice_kinetic = 0.0;
-  if (model.nodes.size() < kParallelNodes || free_node_count(model) < kParallelNodes) {
-    // Nodes of one block are contiguous: one flat loop per free block, one running sum.
-    for (const Block& block : model.blocks) {
-      if (block.fixed) continue;
-      update_nodes(a, dt, block.first_node, block.first_node + block.node_count, twice_kinetic);
-    }
-    return 0.5 * twice_kinetic;
-  }
-  // One small allocation per step on this path (a few hundred bytes against ~1 ms of work).
-  const std::vector<NodeRange> chunks = free_node_chunks(model);
-  std::vector<double> sums(chunks.size(), 0.0);
-  const std::int64_t count = std::int64_t(chunks.size());
-#pragma omp parallel for schedule(static) if (threads_available())
-  for (std::int64_t k = 0; k < count; ++k)
-    update_nodes(a, dt, chunks[k].begin, chunks[k].end, sums[k]);
-  for (const double s : sums) twice_kinetic += s;
-  return 0.5 * twice_kinetic;
+  // Nodes of one block are contiguous: flat loops over free blocks or chunks of them.
+  return 0.5 * sum_over_free_nodes<double>(model, [&a, dt](Index begin, Index end, double& k2) {
+           update_nodes(a, dt, begin, end, k2);
+         });
 }
 
 }  // namespace voussoir

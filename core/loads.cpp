@@ -8,9 +8,6 @@
 
 #include "core/loads.hpp"
 
-#include <cstdint>
-#include <vector>
-
 #include "core/parallel.hpp"
 
 namespace voussoir {
@@ -38,23 +35,9 @@ inline void load_nodes(Nodes& nodes, double ax, double ay, Index begin, Index en
 }  // namespace
 
 Vec2 add_body_loads(Model& model, double ax, double ay) {
-  Vec2 momentum{0.0, 0.0};
-  if (model.nodes.size() < kParallelNodes || free_node_count(model) < kParallelNodes) {
-    for (const Block& block : model.blocks) {
-      if (block.fixed) continue;
-      load_nodes(model.nodes, ax, ay, block.first_node, block.first_node + block.node_count,
-                 momentum);
-    }
-    return momentum;
-  }
-  const std::vector<NodeRange> chunks = free_node_chunks(model);
-  std::vector<Vec2> sums(chunks.size(), Vec2{0.0, 0.0});
-  const std::int64_t count = std::int64_t(chunks.size());
-#pragma omp parallel for schedule(static) if (threads_available())
-  for (std::int64_t k = 0; k < count; ++k)
-    load_nodes(model.nodes, ax, ay, chunks[k].begin, chunks[k].end, sums[k]);
-  for (const Vec2& s : sums) momentum.x += s.x, momentum.y += s.y;
-  return momentum;
+  return sum_over_free_nodes<Vec2>(model, [&model, ax, ay](Index begin, Index end, Vec2& p) {
+    load_nodes(model.nodes, ax, ay, begin, end, p);
+  });
 }
 
 }  // namespace voussoir
