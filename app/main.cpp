@@ -97,7 +97,8 @@ int main(int argc, char** argv) {
   capacity->add_option("--max-time", cap_opts.criteria.max_time, "trial time limit [s]")
       ->check(CLI::PositiveNumber);
   capacity->add_option("--settle-time", cap_opts.criteria.settle_max_time,
-                       "longest settle under gravity before the trials [s] (default 2)")
+                       "longest settle under gravity before the trials [s]")
+      ->capture_default_str()
       ->check(CLI::PositiveNumber);
 
   voussoir::LimitCommandOptions limit_opts;
@@ -136,7 +137,8 @@ int main(int argc, char** argv) {
   sweep->add_option("--csv", sweep_opts.csv, "CSV output (default sweep.csv)");
   sweep->add_option("--plot", sweep_opts.plot, "PNG plot of lambda* over the grid");
   sweep->add_option("--settle-time", sweep_opts.criteria.settle_max_time,
-                    "longest settle under gravity before each cell's trials [s] (default 2)")
+                    "longest settle under gravity before each cell's trials [s]")
+      ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sweep->add_option("--resume", sweep_opts.resume,
                     "journal of finished cells: created, or resumed after a kill");

@@ -2,12 +2,12 @@
 //
 // Threads. With OpenMP and at least kParallelPairs candidates, one parallel region per step:
 // pairs are evaluated in parallel (each pair owns its friction state) and write their corner
-// forces to their own slots (core/node_slots.hpp: -0.0 for a pair that does not touch); after
-// one barrier each node sums its slots in ascending pair order (node -> slot CSR built at the
-// first threaded step after a detection), which is the sequence of additions of the
-// one-thread loop, while one thread sums the energies of the touching pairs in pair order.
-// So forces and energies are bit-identical to the one-thread loop for any thread count (no
-// atomics, no per-thread force arrays). Below that size, or inside an enclosing parallel region
+// forces to their own slots; after one barrier each thread walks the touching pairs in pair
+// order and adds the corners whose node lies in its own range of node ids (ranges cut at
+// equal shares of the candidates' corners, once per detection), which gives every node the
+// sequence of additions of the one-thread loop; the first thread also sums the energies in
+// pair order. So forces and energies are bit-identical to the one-thread loop for any thread
+// count (no atomics, no per-thread force arrays), and only the touching pairs are read. Below that size, or inside an enclosing parallel region
 // (parallel sweeps), one thread evaluates and adds each pair in turn.
 //
 // Stable time step contribution (max_omega_squared). Model: a boundary edge k of length L
@@ -37,6 +37,8 @@
 
 #include "contact/contact.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -47,7 +49,6 @@
 #include "contact/broad_phase.hpp"
 #include "contact/friction.hpp"
 #include "contact/narrow_phase.hpp"
-#include "core/node_slots.hpp"
 #include "core/parallel.hpp"
 
 namespace voussoir {
@@ -106,12 +107,14 @@ struct ContactSystem::Impl {
   std::vector<double> slot_fx, slot_fy;      // [kPairSlots p + 2 k + side] [N]
   std::vector<double> pair_sums;             // [3 p ..]: energy, stored, dissipated [J]
   std::vector<unsigned char> pair_touching;  // 1 when pair p touches
-  NodeSlots node_slots;                      // per node its slots, in ascending pair order
-  bool slots_built = false;                  // node_slots is that of the current pairs
+  // Thread k adds to the nodes [owner_cut[k], owner_cut[k + 1]); empty = not yet cut for the
+  // current pairs (cut for a team of owner_cut.size() - 1 threads).
+  std::vector<Index> owner_cut;
 
   void index_pairs(const Model& model);
   void record_detection(const Nodes& nodes);
-  void build_slots(Index node_count);
+  void cut_owners(Index node_count, int threads);
+  void add_owned(Index lo, Index hi, double* fx, double* fy) const;
   void store(std::size_t p, const PairResult* r);
 
   template <bool kFriction>
@@ -204,41 +207,55 @@ void ContactSystem::Impl::index_pairs(const Model& model) {
     pt0[p] = t.n0[b], pt1[p] = t.n1[b], pt2[p] = t.n2[b];
     kt[p] = scale * (3.0 / height[a] + 3.0 / height[b]) * std::min(edge_len[a], edge_len[b]);
   }
-  slots_built = false;
+  owner_cut.clear();
 }
 
-// Slot buffers and the node -> slot CSR of the threaded path for the current pairs.
-void ContactSystem::Impl::build_slots(Index node_count) {
+// Node ranges of `threads` threads for the current pairs: cut where the running count of
+// candidate corners per node id passes k / threads of the total (a pair's corners are where
+// its forces go when it touches).
+void ContactSystem::Impl::cut_owners(Index node_count, int threads) {
   const std::size_t np = pairs.size();
-  slot_fx.resize(kPairSlots * np);
-  slot_fy.resize(kPairSlots * np);
-  pair_sums.resize(3 * np);
-  pair_touching.resize(np);
-  build_node_slots(
-      node_count,
-      [this, np](auto&& add) {
-        for (std::size_t p = 0; p < np; ++p) {
-          const Index c[3] = {pc0[p], pc1[p], pc2[p]};
-          const Index d[3] = {pt0[p], pt1[p], pt2[p]};
-          const Index first = Index(kPairSlots * p);
-          for (int k = 0; k < 3; ++k) add(c[k], first + 2 * k), add(d[k], first + 2 * k + 1);
-        }
-      },
-      node_slots);
-  slots_built = true;
+  std::vector<std::int64_t> corners(std::size_t(node_count), 0);
+  for (const auto* v : {&pc0, &pc1, &pc2, &pt0, &pt1, &pt2})
+    for (Index i : *v) ++corners[std::size_t(i)];
+  const std::int64_t total = std::int64_t(kPairSlots * np);
+  owner_cut.assign(std::size_t(threads) + 1, node_count);
+  owner_cut[0] = 0;
+  std::int64_t seen = 0;
+  int k = 1;
+  for (Index i = 0; i < node_count && k < threads; ++i) {
+    seen += corners[std::size_t(i)];
+    while (k < threads && seen * threads >= total * k) owner_cut[std::size_t(k++)] = i + 1;
+  }
 }
 
-// Writes pair p's result (or, for r == nullptr, a pair that does not touch: -0.0, which adds
-// nothing) to its slots.
+// Adds the corner forces of the touching pairs, in pair order, to the nodes in [lo, hi).
+void ContactSystem::Impl::add_owned(Index lo, Index hi, double* fx, double* fy) const {
+  const std::size_t np = pairs.size();
+  auto add = [lo, hi, fx, fy](Index i, double x, double y) {
+    if (i >= lo && i < hi) fx[i] += x, fy[i] += y;
+  };
+  for (std::size_t p = 0; p < np; ++p) {
+    if (!pair_touching[p]) continue;
+    const double* on_x = slot_fx.data() + kPairSlots * p;
+    const double* on_y = slot_fy.data() + kPairSlots * p;
+    const Index c[3] = {pc0[p], pc1[p], pc2[p]};
+    const Index d[3] = {pt0[p], pt1[p], pt2[p]};
+    for (int k = 0; k < 3; ++k) {
+      add(c[k], on_x[2 * k], on_y[2 * k]);
+      add(d[k], on_x[2 * k + 1], on_y[2 * k + 1]);
+    }
+  }
+}
+
+// Writes pair p's result to its slots (r == nullptr: the pair does not touch, and its slots are
+// not read).
 void ContactSystem::Impl::store(std::size_t p, const PairResult* r) {
   double* fx = slot_fx.data() + kPairSlots * p;
   double* fy = slot_fy.data() + kPairSlots * p;
   double* sums = pair_sums.data() + 3 * p;
   pair_touching[p] = r != nullptr;
-  if (r == nullptr) {
-    for (int j = 0; j < kPairSlots; ++j) fx[j] = fy[j] = -0.0;
-    return;
-  }
+  if (r == nullptr) return;
   for (int k = 0; k < 3; ++k) {
     fx[2 * k] = r->on_c[k].x, fy[2 * k] = r->on_c[k].y;
     fx[2 * k + 1] = r->on_t[k].x, fy[2 * k + 1] = r->on_t[k].y;
@@ -483,13 +500,14 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
   const std::size_t np = pairs.size();
   if (np >= parallel_pairs && threads_available()) {
     // Pairs are independent (each owns its friction state) and write their own slots; then
-    // each node adds its slots in pair order and one thread the energies in pair order:
-    // the additions of the one-thread path, so bit-identical to it.
-    if (!slots_built) build_slots(n.size());
+    // each thread adds the touching pairs' corners on its own nodes in pair order and the
+    // first thread the energies in pair order: the additions of the one-thread path, so
+    // bit-identical to it.
     const std::int64_t count = static_cast<std::int64_t>(np);
-    const std::int64_t nodes = gathered_nodes(node_slots);
-    const double* sfx = slot_fx.data();
-    const double* sfy = slot_fy.data();
+    slot_fx.resize(kPairSlots * np);  // every slot read is written first in this step
+    slot_fy.resize(kPairSlots * np);
+    pair_sums.resize(3 * np);
+    pair_touching.resize(np);
 #pragma omp parallel
     {
       // Touching pairs cluster in the pair list (sorted by triangle id): chunks of 256 pairs
@@ -499,17 +517,18 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
         PairResult r;
         store(p, evaluate<kFriction>(p, n, dt, r) ? &r : nullptr);
       }
-      // Static split: the work per thread is a function of the model (reproducible counts in
-      // callgrind); the first thread done with its share sums the energies.
-#pragma omp for schedule(static) nowait
-      for (std::int64_t k = 0; k < nodes; ++k) gather_node_slots(node_slots, k, sfx, sfy, fx, fy);
-#pragma omp single nowait
-      for (std::size_t p = 0; p < np; ++p) {
-        if (!pair_touching[p]) continue;
-        ++n_active;
-        energy += pair_sums[3 * p];
-        stored += pair_sums[3 * p + 1];
-        dissipated += pair_sums[3 * p + 2];
+      const int threads = omp_get_num_threads(), me = omp_get_thread_num();
+#pragma omp single
+      if (owner_cut.size() != std::size_t(threads) + 1) cut_owners(n.size(), threads);
+      add_owned(owner_cut[me], owner_cut[me + 1], fx, fy);
+      if (me == 0) {
+        for (std::size_t p = 0; p < np; ++p) {
+          if (!pair_touching[p]) continue;
+          ++n_active;
+          energy += pair_sums[3 * p];
+          stored += pair_sums[3 * p + 1];
+          dissipated += pair_sums[3 * p + 2];
+        }
       }
     }
   } else {

@@ -52,6 +52,7 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   const double d_collapse = crit.collapse_displacement * s.l_ref;
   const std::vector<BlockMotion> start = block_motions(sim.model);
   RestDetector rest(v_rest, crit.hold_time);
+  ProgressTicker progress(quiet);
   while (sim.ctx.time < crit.settle_max_time) {
     const double ramp = std::min(1.0, sim.ctx.time / crit.ramp_time);
     set_static_load(sim, s.gravity * ramp, 0.0);
@@ -61,6 +62,11 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
     const MotionExtent moved = largest_motion(sim.model, start);
     s.max_displacement = moved.displacement;
     s.max_rotation = moved.rotation;
+    if (progress.due())
+      std::fprintf(stderr,
+                   "  settling: %.3f s simulated, largest block motion %.3g m, %.3g rad "
+                   "(%.0f s wall)\n",
+                   sim.ctx.time, moved.displacement, moved.rotation, progress.wall());
     if (moved.displacement > d_collapse || moved.rotation > crit.collapse_rotation) {
       s.collapsed = true;  // no need to wait for the time limit
       break;
@@ -99,7 +105,8 @@ std::string unsettled_message(const SettledState& s, const TrialCriteria& crit) 
   return buf;
 }
 
-TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& crit) {
+TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& crit,
+                      bool quiet) {
   const auto t0 = Clock::now();
   Simulation sim = settled.sim;  // deep copy
   const double g = settled.gravity;
@@ -114,6 +121,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   TrialResult r;
   r.lambda = lambda;
   RestDetector rest(v_rest, crit.hold_time);
+  ProgressTicker progress(quiet);
   // Motion measure m(t) = max over blocks of max(d / d_collapse, |rotation| / rot_collapse)
   // (1 = collapse) sampled in time, for the timeout decision.
   std::vector<double> measure;
@@ -130,6 +138,11 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
     r.max_displacement = dmax;
     r.max_rotation = rmax;
     measure.push_back(std::max(dmax / d_collapse, rmax / crit.collapse_rotation));
+    if (progress.due())
+      std::fprintf(stderr,
+                   "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
+                   "criterion (%.0f s wall)\n",
+                   lambda, elapsed, 100.0 * measure.back(), progress.wall());
     if (dmax > d_collapse || rmax > crit.collapse_rotation) {
       r.collapsed = true;
       r.reason = dmax > d_collapse ? "displacement" : "rotation";
@@ -357,7 +370,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
 #pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, std::min(n, omp_get_max_threads())))
     for (int k = 0; k < n; ++k) {
       const int i = todo[k];
-      out[i] = run_trial(settled, lambdas[i], crit);
+      out[i] = run_trial(settled, lambdas[i], crit, quiet);
 #pragma omp critical(voussoir_journal)
       journal.append(out[i]);
     }

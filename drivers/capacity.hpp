@@ -80,8 +80,10 @@ SettledState settle(const Config& config, const TrialCriteria& criteria, bool qu
 // Why a settle did not end at rest, for the error of the commands that need rest.
 std::string unsettled_message(const SettledState& settled, const TrialCriteria& criteria);
 
-// One trial from a copy of the settled state.
-TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria);
+// One trial from a copy of the settled state; unless quiet, a progress line on stderr every
+// kProgressPeriod of wall time.
+TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria,
+                      bool quiet);
 
 // How the search starts and what it remembers.
 struct CapacitySearch {

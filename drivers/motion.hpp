@@ -25,6 +25,26 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Progress of a long run on stderr: due() is true once every kProgressPeriod of wall time
+// (never when quiet), so a settle or trial of a large scene says where it is.
+constexpr double kProgressPeriod = 30.0;  // [s] wall
+
+class ProgressTicker {
+ public:
+  explicit ProgressTicker(bool quiet) : quiet_(quiet) {}
+  bool due() {
+    if (quiet_ || seconds_since(t0_) < next_) return false;
+    next_ += kProgressPeriod;
+    return true;
+  }
+  double wall() const { return seconds_since(t0_); }
+
+ private:
+  bool quiet_;
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+  double next_ = kProgressPeriod;
+};
+
 // Largest speed of any free node [m/s].
 inline double max_free_speed(const Nodes& n) {
   double v2 = 0.0;
