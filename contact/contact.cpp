@@ -7,8 +7,9 @@
 // equal shares of the candidates' corners, once per detection), which gives every node the
 // sequence of additions of the one-thread loop; the first thread also sums the energies in
 // pair order. So forces and energies are bit-identical to the one-thread loop for any thread
-// count (no atomics, no per-thread force arrays), and only the touching pairs are read. Below that size, or inside an enclosing parallel region
-// (parallel sweeps), one thread evaluates and adds each pair in turn.
+// count (no atomics, no per-thread force arrays), and only the touching pairs are read. Below
+// that size, or inside an enclosing parallel region (parallel sweeps), one thread evaluates
+// and adds each pair in turn.
 //
 // Stable time step contribution (max_omega_squared). Model: a boundary edge k of length L
 // pressed flat into a partner face by a depth d. The overlap is a strip of area L d lying in
@@ -107,8 +108,8 @@ struct ContactSystem::Impl {
   std::vector<double> slot_fx, slot_fy;      // [kPairSlots p + 2 k + side] [N]
   std::vector<double> pair_sums;             // [3 p ..]: energy, stored, dissipated [J]
   std::vector<unsigned char> pair_touching;  // 1 when pair p touches
-  // Thread k adds to the nodes [owner_cut[k], owner_cut[k + 1]); empty = not yet cut for the
-  // current pairs (cut for a team of owner_cut.size() - 1 threads).
+  // Node range k is [owner_cut[k], owner_cut[k + 1]), one per thread; empty = not yet cut for
+  // the current pairs.
   std::vector<Index> owner_cut;
 
   void index_pairs(const Model& model);
@@ -508,6 +509,8 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
     slot_fy.resize(kPairSlots * np);
     pair_sums.resize(3 * np);
     pair_touching.resize(np);
+    const int ranges = omp_get_max_threads();
+    if (owner_cut.size() != std::size_t(ranges) + 1) cut_owners(n.size(), ranges);
 #pragma omp parallel
     {
       // Touching pairs cluster in the pair list (sorted by triangle id): chunks of 256 pairs
@@ -517,10 +520,9 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
         PairResult r;
         store(p, evaluate<kFriction>(p, n, dt, r) ? &r : nullptr);
       }
-      const int threads = omp_get_num_threads(), me = omp_get_thread_num();
-#pragma omp single
-      if (owner_cut.size() != std::size_t(threads) + 1) cut_owners(n.size(), threads);
-      add_owned(owner_cut[me], owner_cut[me + 1], fx, fy);
+      // One range per thread; a smaller team than asked for takes the rest in turn.
+      const int me = omp_get_thread_num(), team = omp_get_num_threads();
+      for (int k = me; k < ranges; k += team) add_owned(owner_cut[k], owner_cut[k + 1], fx, fy);
       if (me == 0) {
         for (std::size_t p = 0; p < np; ++p) {
           if (!pair_touching[p]) continue;

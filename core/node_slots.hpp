@@ -2,12 +2,13 @@
 // Deterministic threaded scatter: per-slot force buffers gathered per node in a fixed order.
 //
 // A one-thread loop adds item contributions into the node forces, fx[i] += slot value, in item
-// order. The threaded stages (core/cst.cpp elements, contact/contact.cpp pairs) instead let
-// each item write its contributions to its own slots of flat buffers, in parallel, and then
-// let each node sum its slots in the order the one-thread loop would have added them, also in
-// parallel (each node is written by one thread only). That is the same sequence of
-// floating-point additions onto fx[i]: bit-identical to the one-thread loop for any thread
-// count, with no atomics and no per-thread force arrays.
+// order. The threaded element stage (core/cst.cpp) instead lets each item write its
+// contributions to its own slots of flat buffers, in parallel, and then lets each node sum its
+// slots in the order the one-thread loop would have added them, also in parallel (each node is
+// written by one thread only). That is the same sequence of floating-point additions onto
+// fx[i]: bit-identical to the one-thread loop for any thread count, with no atomics and no
+// per-thread force arrays. (The contact stage, where few of the candidate pairs carry forces,
+// walks only the touching pairs instead: contact/contact.cpp.)
 //
 // Layout (CSR over the nodes that receive at least one contribution):
 //   node[k]: the k-th such node, ascending ids;

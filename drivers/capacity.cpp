@@ -64,9 +64,10 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
     s.max_rotation = moved.rotation;
     if (progress.due())
       std::fprintf(stderr,
-                   "  settling: %.3f s simulated, largest block motion %.3g m, %.3g rad "
-                   "(%.0f s wall)\n",
-                   sim.ctx.time, moved.displacement, moved.rotation, progress.wall());
+                   "  settling: %.3f s simulated, largest block motion %.3g m, %.3g rad, speed "
+                   "%.2g x the rest speed (%.0f s wall)\n",
+                   sim.ctx.time, moved.displacement, moved.rotation,
+                   max_free_speed(sim.model.nodes) / v_rest, progress.wall());
     if (moved.displacement > d_collapse || moved.rotation > crit.collapse_rotation) {
       s.collapsed = true;  // no need to wait for the time limit
       break;
@@ -141,8 +142,9 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
     if (progress.due())
       std::fprintf(stderr,
                    "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
-                   "criterion (%.0f s wall)\n",
-                   lambda, elapsed, 100.0 * measure.back(), progress.wall());
+                   "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
+                   lambda, elapsed, 100.0 * measure.back(),
+                   max_free_speed(sim.model.nodes) / v_rest, progress.wall());
     if (dmax > d_collapse || rmax > crit.collapse_rotation) {
       r.collapsed = true;
       r.reason = dmax > d_collapse ? "displacement" : "rotation";
