@@ -40,6 +40,7 @@
 
 #include <omp.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -49,6 +50,7 @@
 
 #include "contact/broad_phase.hpp"
 #include "contact/friction.hpp"
+#include "contact/joint_stiffness.hpp"
 #include "contact/narrow_phase.hpp"
 #include "core/parallel.hpp"
 
@@ -74,6 +76,10 @@ struct PairResult {
   struct {
     double x, y;
   } on_c[3], on_t[3];
+  // Impact damping part of on_c/on_t (written only when restitution < 1), for its ledger.
+  struct {
+    double x, y;
+  } damp_c[3], damp_t[3];
 };
 
 }  // namespace
@@ -88,6 +94,13 @@ struct ContactSystem::Impl {
   // Candidate pairs (triangle ids, sorted) and their friction state.
   std::vector<IndexPair> pairs, next_pairs;
   std::vector<double> sx, sy, kt, next_sx, next_sy;
+  // Joint stiffness (contact/joint_stiffness.hpp): per-pair penalty x thickness [Pa m] when
+  // `joints`; impact damping: per-pair beta [s] and |f| of the last step [N] when `damping`,
+  // and per node the damping force of this and of the last step (for the ledger's trapezoid).
+  bool joints = false, damping = false;
+  std::vector<double> ep_thick, beta, prev_fn, next_prev_fn, scratch;
+  std::vector<double> fd_x, fd_y, fd_prev_x, fd_prev_y;
+  std::vector<double> slot_dx, slot_dy;  // threaded path: damping part of the corner slots
   // Nodes of each pair's two triangles (c = pairs[p].a, t = pairs[p].b), filled at detection
   // so that the per-step loop reads one flat array per corner instead of pairs -> tris -> nodes.
   std::vector<Index> pc0, pc1, pc2, pt0, pt1, pt2;
@@ -115,7 +128,7 @@ struct ContactSystem::Impl {
   void index_pairs(const Model& model);
   void record_detection(const Nodes& nodes);
   void cut_owners(Index node_count, int threads);
-  void add_owned(Index lo, Index hi, double* fx, double* fy) const;
+  void add_owned(Index lo, Index hi, double* fx, double* fy);
   void store(std::size_t p, const PairResult* r);
 
   template <bool kFriction>
@@ -141,6 +154,13 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
   s.params = params;
   s.penalty = params.penalty > 0.0 ? params.penalty : 100.0 * model.material.lame_lambda();
   s.thickness = model.out_of_plane;
+  s.joints = params.normal_stiffness > 0.0 || params.joint_young > 0.0;
+  s.damping = params.restitution < 1.0;
+  s.ep_thick.clear();
+  s.beta.clear();
+  s.prev_fn.clear();
+  s.fd_x.assign(s.damping ? model.nodes.x.size() : 0, 0.0);
+  s.fd_y = s.fd_prev_x = s.fd_prev_y = s.fd_x;
   const Participants parts = select_participants(model);
   const double buffer = params.buffer > 0.0 ? params.buffer : default_buffer(model, parts);
   s.broad.setup(model, buffer);
@@ -187,6 +207,10 @@ void ContactSystem::detect(const Model& model) {
   if (!s.ready) return;
   s.broad.detect(model.nodes, s.next_pairs);
   carry_friction_history(s.pairs, s.sx, s.sy, s.next_pairs, s.next_sx, s.next_sy);
+  if (s.damping) {
+    carry_friction_history(s.pairs, s.prev_fn, s.prev_fn, s.next_pairs, s.next_prev_fn, s.scratch);
+    std::swap(s.prev_fn, s.next_prev_fn);
+  }
   std::swap(s.pairs, s.next_pairs);
   std::swap(s.sx, s.next_sx);
   std::swap(s.sy, s.next_sy);
@@ -202,11 +226,21 @@ void ContactSystem::Impl::index_pairs(const Model& model) {
   for (auto* v : {&pc0, &pc1, &pc2, &pt0, &pt1, &pt2}) v->resize(np);
   const Triangles& t = model.tris;
   const double scale = kTangentialStiffnessRatio * penalty * thickness;
+  const bool mapped = joints || params.shear_stiffness > 0.0 || damping;
+  if (joints) ep_thick.resize(np);
+  if (damping) beta.resize(np), prev_fn.resize(np, 0.0);
+  const double zeta = restitution_damping_ratio(params.restitution);
   for (std::size_t p = 0; p < np; ++p) {
     const Index a = pairs[p].a, b = pairs[p].b;
     pc0[p] = t.n0[a], pc1[p] = t.n1[a], pc2[p] = t.n2[a];
     pt0[p] = t.n0[b], pt1[p] = t.n1[b], pt2[p] = t.n2[b];
     kt[p] = scale * (3.0 / height[a] + 3.0 / height[b]) * std::min(edge_len[a], edge_len[b]);
+    if (!mapped) continue;
+    const PairJoint j = pair_joint(model, a, b, params.normal_stiffness, params.joint_young,
+                                   penalty, params.shear_stiffness, thickness);
+    if (joints) ep_thick[p] = j.ep * thickness;
+    if (joints || params.shear_stiffness > 0.0) kt[p] = j.kt > 0.0 ? j.kt : kt[p];
+    if (damping) beta[p] = j.omega > 0.0 ? 2.0 * zeta / j.omega : 0.0;
   }
   owner_cut.clear();
 }
@@ -231,7 +265,7 @@ void ContactSystem::Impl::cut_owners(Index node_count, int threads) {
 }
 
 // Adds the corner forces of the touching pairs, in pair order, to the nodes in [lo, hi).
-void ContactSystem::Impl::add_owned(Index lo, Index hi, double* fx, double* fy) const {
+void ContactSystem::Impl::add_owned(Index lo, Index hi, double* fx, double* fy) {
   const std::size_t np = pairs.size();
   auto add = [lo, hi, fx, fy](Index i, double x, double y) {
     if (i >= lo && i < hi) fx[i] += x, fy[i] += y;
@@ -245,6 +279,15 @@ void ContactSystem::Impl::add_owned(Index lo, Index hi, double* fx, double* fy) 
     for (int k = 0; k < 3; ++k) {
       add(c[k], on_x[2 * k], on_y[2 * k]);
       add(d[k], on_x[2 * k + 1], on_y[2 * k + 1]);
+    }
+    if (!damping) continue;
+    const double* d_x = slot_dx.data() + kPairSlots * p;
+    const double* d_y = slot_dy.data() + kPairSlots * p;
+    double* gx = fd_x.data();
+    double* gy = fd_y.data();
+    for (int k = 0; k < 3; ++k) {
+      if (c[k] >= lo && c[k] < hi) gx[c[k]] += d_x[2 * k], gy[c[k]] += d_y[2 * k];
+      if (d[k] >= lo && d[k] < hi) gx[d[k]] += d_x[2 * k + 1], gy[d[k]] += d_y[2 * k + 1];
     }
   }
 }
@@ -262,6 +305,13 @@ void ContactSystem::Impl::store(std::size_t p, const PairResult* r) {
     fx[2 * k + 1] = r->on_t[k].x, fy[2 * k + 1] = r->on_t[k].y;
   }
   sums[0] = r->energy, sums[1] = r->stored, sums[2] = r->dissipated;
+  if (!damping) return;
+  double* dx = slot_dx.data() + kPairSlots * p;
+  double* dy = slot_dy.data() + kPairSlots * p;
+  for (int k = 0; k < 3; ++k) {
+    dx[2 * k] = r->damp_c[k].x, dy[2 * k] = r->damp_c[k].y;
+    dx[2 * k + 1] = r->damp_t[k].x, dy[2 * k + 1] = r->damp_t[k].y;
+  }
 }
 
 void ContactSystem::Impl::record_detection(const Nodes& nodes) {
@@ -275,10 +325,12 @@ void ContactSystem::Impl::record_detection(const Nodes& nodes) {
 }
 
 // State bytes: u64 tag, u8 ready, u8 detected, i64 detections, i64 active, then the arrays
-// detected_x, detected_y, pairs, sx, sy (each u64 count then the items).
+// detected_x, detected_y, pairs, sx, sy (each u64 count then the items); from tag 2 on, the
+// impact damping's prev_fn (per pair), fd_prev_x and fd_prev_y (per node), empty without it.
 namespace {
 
-constexpr std::uint64_t kStateTag = 0x564f555353434f31ull;  // "VOUSSCO1"
+constexpr std::uint64_t kStateTag1 = 0x564f555353434f31ull;  // "VOUSSCO1": no damping arrays
+constexpr std::uint64_t kStateTag = 0x564f555353434f32ull;   // "VOUSSCO2"
 
 void put_bytes(std::vector<char>& out, const void* p, std::size_t n) {
   const std::size_t at = out.size();
@@ -335,19 +387,33 @@ std::vector<char> ContactSystem::save_state() const {
   put_array(out, s.pairs);
   put_array(out, s.sx);
   put_array(out, s.sy);
+  put_array(out, s.prev_fn);
+  put_array(out, s.fd_prev_x);
+  put_array(out, s.fd_prev_y);
   return out;
 }
 
 void ContactSystem::restore_state(const Model& model, const std::vector<char>& bytes) {
   Impl& s = *impl_;
   StateReader in{bytes};
-  if (in.get<std::uint64_t>() != kStateTag) in.fail("not a contact state");
+  const auto tag = in.get<std::uint64_t>();
+  if (tag != kStateTag && tag != kStateTag1) in.fail("not a contact state");
   const bool ready = in.get<std::uint8_t>() != 0, detected = in.get<std::uint8_t>() != 0;
   const auto detections = in.get<std::int64_t>(), active = in.get<std::int64_t>();
   std::vector<double> dx = in.get_array<double>(), dy = in.get_array<double>();
   std::vector<IndexPair> pairs = in.get_array<IndexPair>();
   std::vector<double> sx = in.get_array<double>(), sy = in.get_array<double>();
+  std::vector<double> prev_fn, fd_prev_x, fd_prev_y;
+  if (tag == kStateTag) {
+    prev_fn = in.get_array<double>();
+    fd_prev_x = in.get_array<double>();
+    fd_prev_y = in.get_array<double>();
+  }
   if (in.pos != bytes.size()) in.fail("unexpected data after the state");
+  if (s.damping && (fd_prev_x.size() != s.fd_x.size() || fd_prev_y.size() != s.fd_x.size()))
+    in.fail("written without the impact damping (contact.restitution) of this model");
+  if (!s.damping && !fd_prev_x.empty())
+    in.fail("written with an impact damping (contact.restitution) this model does not have");
   if (ready != s.ready) in.fail("written with contact " + std::string(ready ? "on" : "off"));
   if (!ready) return;
   const std::vector<Index>& free_nodes = s.broad.participants().free_nodes;
@@ -372,6 +438,12 @@ void ContactSystem::restore_state(const Model& model, const std::vector<char>& b
   if (s.pairs != pairs) in.fail("candidate pairs differ from those of the saved detection");
   s.sx = std::move(sx);
   s.sy = std::move(sy);
+  if (s.damping) {
+    if (prev_fn.size() != s.pairs.size()) in.fail("impact damping and pair counts differ");
+    s.prev_fn = std::move(prev_fn);
+    s.fd_prev_x = std::move(fd_prev_x);
+    s.fd_prev_y = std::move(fd_prev_y);
+  }
   s.index_pairs(model);
   s.detected_x = std::move(dx);
   s.detected_y = std::move(dy);
@@ -417,6 +489,7 @@ inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double 
   apart = apart || overlap_negligible(cv, tv);
   if (apart) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
+    if (damping) prev_fn[p] = 0.0;
     return false;
   }
   return evaluate_overlap<kFriction>(p, n, dt, r);
@@ -436,9 +509,10 @@ template <bool kFriction>
                                Vec2{x[pc2[p]], y[pc2[p]]}};
   const std::array<Vec2, 3> tv{Vec2{x[pt0[p]], y[pt0[p]]}, Vec2{x[pt1[p]], y[pt1[p]]},
                                Vec2{x[pt2[p]], y[pt2[p]]}};
-  const PairForce f = triangle_pair_force(cv, tv, penalty * thickness);
+  const PairForce f = triangle_pair_force(cv, tv, joints ? ep_thick[p] : penalty * thickness);
   if (!(f.area > 0.0)) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;
+    if (damping) prev_fn[p] = 0.0;
     return false;
   }
   r.energy = f.energy;
@@ -447,6 +521,18 @@ template <bool kFriction>
   for (int k = 0; k < 3; ++k) {
     r.on_c[k] = {f.on_c[k].x, f.on_c[k].y};
     r.on_t[k] = {f.on_t[k].x, f.on_t[k].y};
+  }
+  if (damping) {
+    // Impact dashpot on the rate of |f| along f (contact/joint_stiffness.hpp).
+    const double fn = std::hypot(f.resultant.x, f.resultant.y);
+    const double scale = fn > 0.0 ? beta[p] * (fn - prev_fn[p]) / (dt * fn) : 0.0;
+    prev_fn[p] = fn;
+    for (int k = 0; k < 3; ++k) {
+      r.damp_c[k] = {scale * f.on_c[k].x, scale * f.on_c[k].y};
+      r.damp_t[k] = {scale * f.on_t[k].x, scale * f.on_t[k].y};
+      r.on_c[k].x += r.damp_c[k].x, r.on_c[k].y += r.damp_c[k].y;
+      r.on_t[k].x += r.damp_t[k].x, r.on_t[k].y += r.damp_t[k].y;
+    }
   }
   if constexpr (kFriction) {
     const double* vx = n.vx.data();
@@ -497,6 +583,13 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
       fx[d[k]] += r.on_t[k].x;
       fy[d[k]] += r.on_t[k].y;
     }
+    if (!damping) return;
+    for (int k = 0; k < 3; ++k) {
+      fd_x[c[k]] += r.damp_c[k].x;
+      fd_y[c[k]] += r.damp_c[k].y;
+      fd_x[d[k]] += r.damp_t[k].x;
+      fd_y[d[k]] += r.damp_t[k].y;
+    }
   };
   const std::size_t np = pairs.size();
   if (np >= parallel_pairs && threads_available()) {
@@ -509,6 +602,7 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
     slot_fy.resize(kPairSlots * np);
     pair_sums.resize(3 * np);
     pair_touching.resize(np);
+    if (damping) slot_dx.resize(kPairSlots * np), slot_dy.resize(kPairSlots * np);
     const int ranges = omp_get_max_threads();
     if (owner_cut.size() != std::size_t(ranges) + 1) cut_owners(n.size(), ranges);
 #pragma omp parallel
@@ -541,6 +635,20 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
   active = n_active;
   ledger.contact = energy + stored;
   if constexpr (kFriction) ledger.friction_dissipated += dissipated;
+  if (damping) {
+    // Work of the dashpots over the last position increment x^n - x^(n-1) = dt v^(n-1/2), by
+    // the trapezoid of their forces at its two ends (node order: independent of the threads).
+    const double* vx = n.vx.data();
+    const double* vy = n.vy.data();
+    double work = 0.0;
+    for (std::size_t i = 0; i < fd_x.size(); ++i) {
+      work += (fd_x[i] + fd_prev_x[i]) * vx[i] + (fd_y[i] + fd_prev_y[i]) * vy[i];
+      fd_prev_x[i] = fd_x[i];
+      fd_prev_y[i] = fd_y[i];
+      fd_x[i] = fd_y[i] = 0.0;
+    }
+    ledger.impact_dissipated -= 0.5 * dt * work;
+  }
 }
 
 void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger) {
@@ -580,29 +688,48 @@ double ContactSystem::max_omega_squared(const Model& model) const {
   }
   // S_i = [sxx sxy; sxy syy] per node.
   std::vector<double> sxx(n.size(), 0.0), sxy(n.size(), 0.0), syy(n.size(), 0.0);
-  for (Index i = 0; i < parts.size(); ++i) {
-    if (parts.fixed[i]) continue;
-    const Index e = parts.tri[i];
-    const double h_partner = parts.block[i] == b1 ? h2 : h1;
-    if (!std::isfinite(h_partner)) continue;
-    const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
-    for (int k = 0; k < 3; ++k) {
-      if (!(t.boundary[e] & (1u << k))) continue;
-      const Index i0 = v[k], i1 = v[(k + 1) % 3];
-      const double dx = n.x0[i1] - n.x0[i0], dy = n.y0[i1] - n.y0[i0];
-      const double len = std::hypot(dx, dy);
-      const double g = 3.0 * len / (2.0 * t.area0[e]) + 3.0 / h_partner;
-      const double ex = dx / len, ey = dy / len;  // edge direction = tangent; normal (-ey, ex)
-      const double k_len = ep * g * len;
-      const double axx = k_len * (ey * ey + tangential * ex * ex);
-      const double axy = k_len * (-ex * ey + tangential * ex * ey);
-      const double ayy = k_len * (ex * ex + tangential * ey * ey);
-      for (Index node : {i0, i1}) {
-        sxx[node] += axx;
-        sxy[node] += axy;
-        syy[node] += ayy;
+  // Calls add(i0, i1, len, g, ex, ey) for every boundary edge of a free participant.
+  auto each_edge = [&](auto&& add) {
+    for (Index i = 0; i < parts.size(); ++i) {
+      if (parts.fixed[i]) continue;
+      const Index e = parts.tri[i];
+      const double h_partner = parts.block[i] == b1 ? h2 : h1;
+      if (!std::isfinite(h_partner)) continue;
+      const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
+      for (int k = 0; k < 3; ++k) {
+        if (!(t.boundary[e] & (1u << k))) continue;
+        const Index i0 = v[k], i1 = v[(k + 1) % 3];
+        const double dx = n.x0[i1] - n.x0[i0], dy = n.y0[i1] - n.y0[i0];
+        const double len = std::hypot(dx, dy);
+        const double g = 3.0 * len / (2.0 * t.area0[e]) + 3.0 / h_partner;
+        add(i0, i1, len, g, dx / len, dy / len);  // edge direction = tangent; normal (-ey, ex)
       }
     }
+  };
+  auto add_to = [&](Index i0, Index i1, double axx, double axy, double ayy) {
+    for (Index node : {i0, i1}) {
+      sxx[node] += axx;
+      sxy[node] += axy;
+      syy[node] += ayy;
+    }
+  };
+  if (s.joints || s.params.shear_stiffness > 0.0) {
+    // A joint stiffness: normal and tangential row sums kn thick L and 2 ks thick L (the pair
+    // penalties give kn on a flat joint whatever the triangles' heights).
+    each_edge([&](Index i0, Index i1, double len, double g, double ex, double ey) {
+      const double kn_len = s.joints ? s.params.normal_stiffness * s.thickness * len : ep * g * len;
+      const double kt_len = s.params.shear_stiffness > 0.0
+                                ? 2.0 * s.params.shear_stiffness * s.thickness * len
+                                : tangential * kn_len;
+      add_to(i0, i1, kn_len * ey * ey + kt_len * ex * ex, -kn_len * ex * ey + kt_len * ex * ey,
+             kn_len * ex * ex + kt_len * ey * ey);
+    });
+  } else {
+    each_edge([&](Index i0, Index i1, double len, double g, double ex, double ey) {
+      const double k_len = ep * g * len;
+      add_to(i0, i1, k_len * (ey * ey + tangential * ex * ex),
+             k_len * (-ex * ey + tangential * ex * ey), k_len * (ex * ex + tangential * ey * ey));
+    });
   }
   double w2 = 0.0;
   for (Index i = 0; i < n.size(); ++i) {
@@ -632,6 +759,110 @@ double ContactSystem::penalty() const {
 }
 double ContactSystem::buffer() const {
   return impl_->broad.buffer();
+}
+
+bool ContactSystem::joint_stiffness_mode() const {
+  return impl_->joints;
+}
+
+// Stable step of rigid blocks. The contact stiffness couples the bodies' coordinates
+// q_b = (c_x, c_y, theta) through each joint. A flat joint of length L between body b and its
+// partner, pressed or sheared anywhere along it, is a row of springs kn t_z ds (normal n) and
+// ks t_z ds (tangent e) at the points P(s); on b's coordinates each spring acts through
+//     g_n = (n_x, n_y, (P - c) x n),    g_t = (e_x, e_y, (P - c) x e),
+// so the joint's stiffness block on b is A_b = integral (kn t_z g_n g_n^T + ks t_z g_t g_t^T) ds
+// (quadratic in s: Simpson's rule is exact). A joint between two free bodies is a positive
+// semi-definite [[A_a, C], [C^T, A_b]] <= 2 diag(A_a, A_b) (the difference is the same matrix
+// with C negated); against a fixed block only A_b remains. Hence the whole stiffness is at most
+// the block diagonal of K_b = sum over b's joints of (2 or 1) A_b, and
+//     omega_max^2 <= max_b lambda_max(M_b^-1/2 K_b M_b^-1/2),    M_b = diag(m, m, I).
+// Joints: the model's (scene generators and the polygon joint search), every face pressed
+// over its whole length. A free block with no joint (one that falls onto something) gets
+// each side of its outline as a face against a fixed support. With impact damping, the
+// dashpots (beta K, contact/joint_stiffness.hpp) damp that mode at the rate beta_b omega^2,
+// beta_b the largest of b's joints; the body with the shortest damped step sets it.
+ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) const {
+  const Impl& s = *impl_;
+  const RigidBodies& r = model.rigid;
+  const std::size_t nb = model.blocks.size();
+  if (!s.ready || r.mass.size() != nb) return {};
+  std::vector<Eigen::Matrix3d> stiffness(nb, Eigen::Matrix3d::Zero());
+  std::vector<double> beta_max(nb, 0.0);
+  std::vector<char> has_face(nb, 0);
+  const double zeta = restitution_damping_ratio(s.params.restitution);
+  auto add_face = [&](Index b, Index partner, const Vec2& p0, const Vec2& p1) {
+    const Block& blk = model.blocks[std::size_t(b)];
+    if (blk.fixed || !(r.mass[b] > 0.0)) return;
+    double ex = p1.x - p0.x, ey = p1.y - p0.y;
+    const double len = std::hypot(ex, ey);
+    if (!(len > 0.0)) return;
+    ex /= len, ey /= len;
+    const Vec2 normal{ey, -ex}, tangent{ex, ey};
+    const Block* other = partner >= 0 ? &model.blocks[std::size_t(partner)] : nullptr;
+    const bool partner_free = other != nullptr && !other->fixed;
+    double kn = s.params.normal_stiffness;
+    if (!(kn > 0.0) && s.params.joint_young > 0.0) {
+      const double lb = extent_along(blk.polygon, normal);
+      const double l = partner_free ? 0.5 * (lb + extent_along(other->polygon, normal)) : lb;
+      kn = s.params.joint_young / l;
+    } else if (!(kn > 0.0)) {
+      // Penalty mode: Ep (3/h_b + 3/h_partner) with the smallest face heights.
+      const double hb = s.block_min_height[std::size_t(b)];
+      double hp = hb;
+      if (partner >= 0) hp = s.block_min_height[std::size_t(partner)];
+      kn = s.penalty * (3.0 / hb + 3.0 / hp);
+    }
+    const double ks =
+        s.params.shear_stiffness > 0.0 ? s.params.shear_stiffness : kTangentialStiffnessRatio * kn;
+    const double kn_t = kn * s.thickness, ks_t = ks * s.thickness;
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    for (int q = 0; q < 3; ++q) {
+      const double w = (q == 1 ? 4.0 : 1.0) * len / 6.0;
+      const double px = p0.x + 0.5 * q * (p1.x - p0.x) - r.cx0[b];
+      const double py = p0.y + 0.5 * q * (p1.y - p0.y) - r.cy0[b];
+      const Eigen::Vector3d gn(normal.x, normal.y, px * normal.y - py * normal.x);
+      const Eigen::Vector3d gt(tangent.x, tangent.y, px * tangent.y - py * tangent.x);
+      a += w * (kn_t * gn * gn.transpose() + ks_t * gt * gt.transpose());
+    }
+    stiffness[std::size_t(b)] += (partner_free ? 2.0 : 1.0) * a;
+    has_face[std::size_t(b)] = 1;
+    if (zeta > 0.0) {
+      double face = extent_along(blk.polygon, tangent);
+      if (other != nullptr) face = std::min(face, extent_along(other->polygon, tangent));
+      const double m = r.mass[b];
+      const double m_eff = partner_free ? m * other->mass / (m + other->mass) : m;
+      const double omega = std::sqrt(kn_t * face / m_eff);
+      beta_max[std::size_t(b)] = std::max(beta_max[std::size_t(b)], 2.0 * zeta / omega);
+    }
+  };
+  for (const Joint& j : model.joints) {
+    add_face(j.block_a, j.block_b, j.a, j.b);
+    add_face(j.block_b, j.block_a, j.a, j.b);
+  }
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (has_face[b]) continue;
+    const std::vector<Vec2>& poly = model.blocks[b].polygon;
+    for (std::size_t k = 0; k < poly.size(); ++k)
+      add_face(Index(b), -1, poly[k], poly[(k + 1) % poly.size()]);
+  }
+  ContactFrequencyBound worst;
+  double worst_step = std::numeric_limits<double>::infinity();
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (!has_face[b]) continue;
+    const Eigen::Vector3d inv_sqrt_m(1.0 / std::sqrt(r.mass[b]), 1.0 / std::sqrt(r.mass[b]),
+                                     1.0 / std::sqrt(r.inertia[b]));
+    const Eigen::Matrix3d scaled = inv_sqrt_m.asDiagonal() * stiffness[b] * inv_sqrt_m.asDiagonal();
+    const double lambda =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scaled).eigenvalues().maxCoeff();
+    const double rate = beta_max[b] * lambda;
+    const double g = 0.5 * rate;
+    const double step = 2.0 / (g + std::sqrt(lambda + g * g));
+    if (step < worst_step) {
+      worst_step = step;
+      worst = {lambda, rate};
+    }
+  }
+  return worst;
 }
 
 }  // namespace voussoir

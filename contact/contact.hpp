@@ -16,6 +16,25 @@ struct ContactParams {
   double penalty = 0.0;   // Ep [Pa] (normal penalty of the potential contact)
   double friction = 0.0;  // Coulomb mu; 0 = no friction work at all
   double buffer = 0.0;    // NBS buffer [m]; 0 = automatic (a fraction of the smallest element)
+  // Joint stiffness in engineering units (contact/joint_stiffness.hpp). normal_stiffness kn
+  // [N/m3] > 0 replaces the single penalty by one per pair that gives kn on a flat joint;
+  // joint_young E [Pa] > 0 (and kn = 0) takes kn = E / l per pair instead (the rigid-block
+  // default). shear_stiffness ks [N/m3]: tangential spring of the friction law; 0 = 1/4 of the
+  // normal stiffness (kTangentialStiffnessRatio).
+  double normal_stiffness = 0.0;
+  double joint_young = 0.0;
+  double shear_stiffness = 0.0;
+  // Coefficient of restitution of a normal impact between two bodies, in [0, 1]; 1 = no impact
+  // damping (contact/joint_stiffness.hpp). Rigid blocks only: on elastic blocks the dashpot
+  // would be tuned to the joint's low frequency and overdamp the element modes that share it.
+  double restitution = 1.0;
+};
+
+// Highest contact frequency bound and the damping rate (c/m) of that mode [1/s2, 1/s], for the
+// stable step of core/step.cpp.
+struct ContactFrequencyBound {
+  double omega_squared = 0.0;
+  double damping_rate = 0.0;
 };
 
 class ContactSystem {
@@ -36,12 +55,17 @@ class ContactSystem {
   // Broad phase: rebuilds the candidate pair list (friction history carried over by key).
   void detect(const Model& model);
   // Narrow phase + friction: adds contact forces into nodes.fx/fy, sets ledger.contact and
-  // accumulates ledger.friction_dissipated.
+  // accumulates ledger.friction_dissipated and ledger.impact_dissipated.
   void add_forces(Model& model, double dt, EnergyLedger& ledger);
 
   // Largest effective contact stiffness per unit nodal mass, for the stable time step:
   // omega_max^2 estimate [1/s2].
   double max_omega_squared(const Model& model) const;
+  // The same for rigid blocks (Model::rigid): from the joints' stiffness and the bodies' mass
+  // and rotational inertia (contact/joint_stiffness.hpp).
+  ContactFrequencyBound rigid_frequency_bound(const Model& model) const;
+  // True when the pairs carry their own penalty from a joint stiffness (kn or E / l).
+  bool joint_stiffness_mode() const;
 
   // Candidate pairs from which add_forces runs on threads (default 8192, contact/contact.cpp
   // kParallelPairs): tests lower it to run the threaded path on small scenes.

@@ -12,10 +12,13 @@ struct EnergyLedger {
   double external_work = 0.0;        // accumulated: body loads, base motion
   double damping_dissipated = 0.0;   // accumulated: Munjiza viscous term
   double friction_dissipated = 0.0;  // accumulated: Coulomb slip
+  double impact_dissipated = 0.0;    // accumulated: contact normal damping (restitution < 1)
   double max_energy = 0.0;           // largest of the terms seen so far (normalises the error)
 
   double stored() const { return kinetic + strain + contact; }
-  double dissipated() const { return damping_dissipated + friction_dissipated; }
+  double dissipated() const {
+    return damping_dissipated + friction_dissipated + impact_dissipated;
+  }
   // |W - K - U - C - D| / max energy seen (0 before anything happened).
   double balance_error() const;
   void update_max();

@@ -93,6 +93,21 @@ struct Joint {
   double position_deg = 0.0;
 };
 
+// Rigid-body state of the blocks made rigid (core/rigid.hpp has the math). Layout: one entry
+// per block (fixed blocks keep zeros and are skipped), rx/ry one per node.
+struct RigidBodies {
+  // hot, per block
+  std::vector<double> cx, cy, theta;    // centroid [m], rotation [rad] from the reference
+  std::vector<double> vx, vy, omega;    // half-step velocity [m/s], angular velocity [rad/s]
+  // cold, per block
+  std::vector<double> cx0, cy0;         // reference centroid [m]
+  std::vector<double> mass, inertia;    // M [kg], polar moment about the centroid [kg m2]
+  // per node: offset from the block's reference centroid [m]
+  std::vector<double> rx, ry;
+
+  bool empty() const { return cx.empty(); }
+};
+
 struct Model {
   Nodes nodes;
   Triangles tris;
@@ -101,6 +116,10 @@ struct Model {
   Material material;
   double out_of_plane = 1.0;         // out-of-plane thickness [m]
   std::string kind;                  // scene kind that built it
+  // Rigid blocks (material.model = "rigid"): every free block is one rigid body, no element
+  // stage. Empty for elastic models.
+  RigidBodies rigid;
+  bool is_rigid() const { return !rigid.empty(); }
 };
 
 // Appends one block made of the given nodes and triangles (node indices local to the block,

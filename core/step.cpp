@@ -11,6 +11,7 @@
 #include "core/cst.hpp"
 #include "core/integrate.hpp"
 #include "core/loads.hpp"
+#include "core/rigid.hpp"
 
 namespace voussoir {
 
@@ -51,6 +52,7 @@ void prepare_context(Simulation& sim, double damping_factor) {
   const double h = min_triangle_height(sim.model);
   sim.ctx.eta =
       std::isfinite(h) ? damping_factor * 2.0 * h * std::sqrt(mat.young * mat.density) : 0.0;
+  if (sim.model.is_rigid()) sim.ctx.eta = 0.0;  // no element stage, nothing to damp there
 }
 
 // Stable step = 2 / (g + sqrt(omega^2 + g^2)) (core/cst.hpp damped_stable_step) with
@@ -59,7 +61,18 @@ void prepare_context(Simulation& sim, double damping_factor) {
 // springs act on the same nodes as the elements, so their stiffnesses add: the sum of the two
 // omega^2 bounds the combined system, whereas the smaller of the two separate limits
 // (min(2/omega_el, 2/omega_c)) can exceed the true limit by up to sqrt(2).
+//
+// Rigid blocks have no element modes: the bound is the contact one over the bodies' mass and
+// rotational inertia (contact/contact.hpp rigid_frequency_bound), and the damping rate that of
+// the contact's impact damping (restitution < 1), if any, times kRigidStepFraction
+// (core/rigid.hpp: the joints' one-sided contact must be resolved, not only kept stable).
 double stable_time_step(const Simulation& sim) {
+  if (sim.model.is_rigid()) {
+    const ContactFrequencyBound c =
+        sim.ctx.contact_on ? sim.contact.rigid_frequency_bound(sim.model) : ContactFrequencyBound{};
+    if (!(c.omega_squared > 0.0)) return std::numeric_limits<double>::infinity();
+    return kRigidStepFraction * damped_stable_step(c.omega_squared, c.damping_rate);
+  }
   const CstFrequencyBound el = max_frequency_bound(sim.model, law_of(sim.ctx));
   double omega_squared = el.omega_squared;
   if (sim.ctx.contact_on) omega_squared += sim.contact.max_omega_squared(sim.model);
@@ -83,15 +96,21 @@ void advance(Simulation& sim) {
   // 2. clear forces
   clear_forces(model.nodes);
 
-  // 3. element forces (CST + Munjiza damping at the half-step velocities)
+  // 3. element forces (CST + Munjiza damping at the half-step velocities); none for rigid
+  //    blocks
+  const bool rigid = model.is_rigid();
   const CstLaw law = law_of(ctx);
-  if (law.eta > 0.0) {
+  if (rigid) {
+    sim.viscous_piola.clear();
+  } else if (law.eta > 0.0) {
     sim.viscous_piola.resize(4 * std::size_t(model.tris.size()), 0.0);  // once
   } else {
     sim.viscous_piola.clear();
   }
-  const ElementStageResult el = add_element_forces(
-      model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr, &sim.element_work);
+  const ElementStageResult el =
+      rigid ? ElementStageResult{}
+            : add_element_forces(model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr,
+                                 &sim.element_work);
   clock.stamp(timers.elements);
 
   // 4. contact forces (sets ledger.contact, accumulates friction dissipation)
@@ -106,8 +125,9 @@ void advance(Simulation& sim) {
   const Vec2 momentum = add_body_loads(model, ctx.body_ax, ctx.body_ay);
   clock.stamp(timers.loads);
 
-  // 6. central difference: v then x
-  const double kinetic = integrate_central_difference(model, ctx.dt);
+  // 6. central difference: v then x (of the nodes, or of the rigid bodies and their nodes)
+  const double kinetic =
+      rigid ? integrate_rigid_bodies(model, ctx.dt) : integrate_central_difference(model, ctx.dt);
   clock.stamp(timers.integrate);
 
   // Energy ledger.

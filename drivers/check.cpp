@@ -82,8 +82,24 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   std::printf("mass        %.6g kg (free blocks, out-of-plane %.4g m)\n", free_mass(m),
               m.out_of_plane);
   std::printf("worst angle %.2f deg\n", worst);
-  std::printf("dt          %.4g s (stable limit %.4g s)\n", info.dt, info.dt_stable);
-  std::printf("penalty     %.4g Pa\n", info.penalty);
+  std::printf("blocks are  %s\n", info.rigid ? "rigid (one body each; no strain energy, no stress "
+                                              "field)"
+                                            : "elastic (constant-strain triangles)");
+  std::printf("dt          %.4g s (stable limit %.4g s, set by the %s)\n", info.dt,
+              info.dt_stable, info.dt_set_by.c_str());
+  if (info.joint_stiffness) {
+    if (config.contact.normal_stiffness > 0.0)
+      std::printf("joints      kn = %.4g N/m3, ks = %.4g N/m3\n", config.contact.normal_stiffness,
+                  config.contact.shear_stiffness > 0.0 ? config.contact.shear_stiffness
+                                                       : 0.25 * config.contact.normal_stiffness);
+    else
+      std::printf("joints      kn = E / l per joint (l: the blocks' length normal to it), ks = %s\n",
+                  config.contact.shear_stiffness > 0.0 ? "contact.shear_stiffness" : "kn / 4");
+  } else {
+    std::printf("penalty     %.4g Pa\n", info.penalty);
+  }
+  if (config.contact.restitution < 1.0)
+    std::printf("restitution %.3g (impact damping)\n", config.contact.restitution);
   std::printf("damping eta %.4g Pa s\n", info.eta);
 
   if (!common.json_path.empty()) {
@@ -98,7 +114,9 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                         {"penalty", info.penalty},
                         {"eta", info.eta},
                         {"worst_angle_deg", worst},
-                        {"joints", m.joints.size()}};
+                        {"joints", m.joints.size()},
+                        {"block_model", info.rigid ? "rigid" : "elastic"},
+                        {"dt_set_by", info.dt_set_by}};
     write_json(j, common.json_path);
   }
   if (!opts.mesh_out.empty()) write_json(model_geometry_json(m), opts.mesh_out);

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/cst.hpp"
+#include "core/rigid.hpp"
 #include "io/deck.hpp"
 #include "mesh/scene.hpp"
 
@@ -25,10 +26,20 @@ void set_static_load(Simulation& sim, double gravity, double lambda) {
 Simulation make_simulation(const Config& config, SetupInfo* info) {
   Simulation sim;
   sim.model = build_model(config);
+  const bool rigid = config.material.model == "rigid";
+  if (rigid) make_blocks_rigid(sim.model);
   ContactParams cp;
   cp.penalty = contact_penalty(config);
   cp.friction = config.contact.friction;
   cp.buffer = config.contact.buffer;
+  cp.normal_stiffness = config.contact.normal_stiffness;
+  cp.shear_stiffness = config.contact.shear_stiffness;
+  cp.restitution = config.contact.restitution;
+  // Rigid blocks with neither a stiffness nor a penalty given: kn = E / l per joint
+  // (contact/joint_stiffness.hpp).
+  if (rigid && !(cp.normal_stiffness > 0.0) && !config.contact.has("penalty") &&
+      !config.contact.has("penalty_factor"))
+    cp.joint_young = config.material.young;
   sim.contact.setup(sim.model, cp);
   prepare_context(sim, config.solver.damping_factor);
   set_static_load(sim, config.load.gravity, config.load.lambda);
@@ -65,6 +76,10 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
     info->dt_stable = dt_stable;
     info->penalty = cp.penalty;
     info->eta = sim.ctx.eta;
+    info->rigid = rigid;
+    info->joint_stiffness = sim.contact.joint_stiffness_mode();
+    info->dt_set_by = rigid ? "rigid bodies on their joints (mass, inertia, joint stiffness)"
+                            : "elements and contact penalty";
   }
   return sim;
 }
@@ -72,6 +87,7 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
 std::vector<double> triangle_stresses(const Simulation& sim) {
   const CstLaw law{sim.ctx.lame_lambda, sim.ctx.shear_modulus, sim.ctx.eta};
   std::vector<double> s(3 * static_cast<size_t>(sim.model.tris.size()));
+  if (sim.model.is_rigid()) return s;  // rigid blocks carry no element stress (not written)
   for (Index e = 0; e < sim.model.tris.size(); ++e) {
     const Stress2 st = triangle_cauchy_stress(sim.model, e, law);
     s[3 * e] = st.xx;

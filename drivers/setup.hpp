@@ -21,6 +21,9 @@ struct SetupInfo {
   double dt_stable = 0.0;    // stable limit before the safety factor [s]
   double penalty = 0.0;      // contact penalty Ep [Pa]
   double eta = 0.0;          // damping viscosity [Pa s]
+  bool rigid = false;        // material.model = "rigid"
+  bool joint_stiffness = false;  // pairs carry a joint stiffness (kn or E / l)
+  std::string dt_set_by;     // what sets the stable step
 };
 
 // Contact penalty of the deck: contact.penalty if given, else penalty_factor x Lamé's first

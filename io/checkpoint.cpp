@@ -23,7 +23,10 @@ namespace {
 
 constexpr char kMagic[] = "VOUSSOIR-CKPT\n";  // 14 characters, no terminator written
 constexpr std::size_t kMagicSize = sizeof(kMagic) - 1;
-constexpr std::uint32_t kVersion = 1;
+// Version 2 adds the impact damping's dissipation to the ledger and the rigid bodies' state
+// (centroid, rotation, velocities: empty arrays for elastic blocks); version 1 files (elastic
+// runs of earlier builds) are still read.
+constexpr std::uint32_t kVersion = 2;
 constexpr std::uint32_t kByteOrderTag = 0x01020304u;
 // Contact kind byte: 1 = ContactSystem::save_state bytes follow. (0 was written by builds
 // without that interface, frictionless runs only; such files are refused.)
@@ -153,6 +156,11 @@ std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
   f.value(sim.contact.penalty());
   f.value(sim.contact.buffer());
   f.value(friction);
+  // Rigid blocks (issue 23): their bodies' mass and inertia. Elastic models hash as before.
+  if (m.is_rigid()) {
+    f.array(m.rigid.mass);
+    f.array(m.rigid.inertia);
+  }
   return f.h;
 }
 
@@ -168,7 +176,7 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
   for (const double v : {c.time, c.dt, c.prev_body_ax, c.prev_body_ay}) o.value(v);
   const EnergyLedger& l = sim.ledger;
   for (const double v : {l.kinetic, l.strain, l.contact, l.external_work, l.damping_dissipated,
-                         l.friction_dissipated, l.max_energy})
+                         l.friction_dissipated, l.impact_dissipated, l.max_energy})
     o.value(v);
   const Nodes& n = sim.model.nodes;
   o.array(n.x);
@@ -176,6 +184,8 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
   o.array(n.vx);
   o.array(n.vy);
   o.array(sim.viscous_piola);
+  const RigidBodies& r = sim.model.rigid;
+  for (const auto* v : {&r.cx, &r.cy, &r.theta, &r.vx, &r.vy, &r.omega}) o.array(*v);
   o.value<std::uint8_t>(kContactBytes);
   o.array(sim.contact.save_state());
   o.array(driver_state);
@@ -206,8 +216,9 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   std::memcpy(&stored_sum, buf.data() + buf.size() - sizeof stored_sum, sizeof stored_sum);
   if (stored_sum != sum.h) in.fail("checksum mismatch (truncated or corrupt)");
   in.pos = kMagicSize;
-  if (const auto v = in.value<std::uint32_t>(); v != kVersion)
-    in.fail("format version " + std::to_string(v) + ", this program reads version " +
+  const auto version = in.value<std::uint32_t>();
+  if (version != kVersion && version != 1)
+    in.fail("format version " + std::to_string(version) + ", this program reads versions 1 and " +
             std::to_string(kVersion));
   if (in.value<std::uint32_t>() != kByteOrderTag)
     in.fail("written on a machine of another byte order");
@@ -224,11 +235,16 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   if (dt != sim.ctx.dt) in.fail("written with another time step");
   EnergyLedger l;
   for (double* v : {&l.kinetic, &l.strain, &l.contact, &l.external_work, &l.damping_dissipated,
-                    &l.friction_dissipated, &l.max_energy})
+                    &l.friction_dissipated})
     *v = in.value<double>();
+  if (version >= 2) l.impact_dissipated = in.value<double>();
+  l.max_energy = in.value<double>();
   std::vector<double> x = in.array<double>(), y = in.array<double>();
   std::vector<double> vx = in.array<double>(), vy = in.array<double>();
   std::vector<double> piola = in.array<double>();
+  std::vector<std::vector<double>> rigid(6);
+  if (version >= 2)
+    for (auto& v : rigid) v = in.array<double>();
   const auto contact_kind = in.value<std::uint8_t>();
   const std::vector<char> contact = in.array<char>();
   std::vector<double> driver = in.array<double>();
@@ -253,6 +269,16 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   n.vx = std::move(vx);
   n.vy = std::move(vy);
   sim.viscous_piola = std::move(piola);
+  RigidBodies& r = sim.model.rigid;
+  const std::size_t bodies = r.cx.size();
+  for (const auto& v : rigid)
+    if (v.size() != bodies)
+      in.fail(bodies == 0 ? "written for rigid blocks, this model's are elastic"
+                          : "rigid body count differs from the model");
+  if (bodies > 0) {
+    r.cx = rigid[0], r.cy = rigid[1], r.theta = rigid[2];
+    r.vx = rigid[3], r.vy = rigid[4], r.omega = rigid[5];
+  }
   try {
     sim.contact.restore_state(sim.model, contact);
   } catch (const std::exception& e) {

@@ -49,6 +49,7 @@ struct MaterialConfig {
   double young = 40e9;                 // Pa
   double poisson = 0.2;
   std::string plane = "strain";        // "strain" or "stress"
+  std::string model = "elastic";       // "elastic" (CST blocks) or "rigid" (core/rigid.hpp)
 };
 
 struct ContactConfig {
@@ -56,6 +57,13 @@ struct ContactConfig {
   double penalty_factor = 100.0;       // Ep = factor x Lamé's first constant
   double penalty = 0.0;                // Ep [Pa]; 0 = use penalty_factor
   double buffer = 0.0;                 // NBS buffer [m]; 0 = automatic
+  // Joint stiffness [N/m3] (contact/joint_stiffness.hpp); 0 = not given: the penalty for
+  // elastic blocks, kn = E / l for rigid ones; shear 0 = 1/4 of the normal stiffness.
+  double normal_stiffness = 0.0;
+  double shear_stiffness = 0.0;
+  double restitution = 1.0;            // impact restitution in [0, 1]; 1 = no impact damping
+  std::vector<std::string> given;      // which [contact] keys the deck gave
+  bool has(const std::string& key) const;
 };
 
 struct SolverConfig {

@@ -41,6 +41,11 @@
 
 namespace voussoir {
 
+bool ContactConfig::has(const std::string& key) const {
+  const std::string leaf = key.rfind("contact.", 0) == 0 ? key.substr(8) : key;
+  return std::find(given.begin(), given.end(), leaf) != given.end();
+}
+
 bool ModelConfig::has(const std::string& key) const {
   // Accepts "embrace" as well as "model.embrace".
   const std::string leaf = key.rfind("model.", 0) == 0 ? key.substr(6) : key;
@@ -305,11 +310,15 @@ const std::vector<KeySpec>& key_table() {
       {"material.young", [](Reader& r, const toml::node& n, Config& c) { c.material.young = r.number(n, above(0), "Pa"); }},
       {"material.poisson", [](Reader& r, const toml::node& n, Config& c) { c.material.poisson = r.number(n, {0, false, 0.5, true}); }},
       {"material.plane", [](Reader& r, const toml::node& n, Config& c) { c.material.plane = r.choice(n, {"strain", "stress"}); }},
+      {"material.model", [](Reader& r, const toml::node& n, Config& c) { c.material.model = r.choice(n, {"elastic", "rigid"}); }},
       // [contact]
       {"contact.friction", [](Reader& r, const toml::node& n, Config& c) { c.contact.friction = r.number(n, at_least(0)); }},
       {"contact.penalty_factor", [](Reader& r, const toml::node& n, Config& c) { c.contact.penalty_factor = r.number(n, above(0), "x Lame's first constant"); }},
       {"contact.penalty", [](Reader& r, const toml::node& n, Config& c) { c.contact.penalty = r.number(n, at_least(0), "Pa, 0 = use contact.penalty_factor"); }},
       {"contact.buffer", [](Reader& r, const toml::node& n, Config& c) { c.contact.buffer = r.number(n, at_least(0), "m, 0 = automatic"); }},
+      {"contact.normal_stiffness", [](Reader& r, const toml::node& n, Config& c) { c.contact.normal_stiffness = r.number(n, above(0), "N/m3"); }},
+      {"contact.shear_stiffness", [](Reader& r, const toml::node& n, Config& c) { c.contact.shear_stiffness = r.number(n, above(0), "N/m3"); }},
+      {"contact.restitution", [](Reader& r, const toml::node& n, Config& c) { c.contact.restitution = r.number(n, {0, false, 1, false}, "coefficient of restitution"); }},
       // [solver]
       {"solver.dt", [](Reader& r, const toml::node& n, Config& c) {
          const char* what = "\"auto\" or a time step > 0 [s]";
@@ -583,6 +592,24 @@ void check_together(const Reader& r, Config& c) {
                                path + "' (" + why + ")"));
     }
   };
+  // A joint stiffness replaces the penalty: both at once is a contradiction.
+  for (const char* stiff : {"contact.normal_stiffness", "contact.shear_stiffness"}) {
+    if (!given(stiff)) continue;
+    for (const char* pen : {"contact.penalty", "contact.penalty_factor"}) {
+      if (!given(pen)) continue;
+      const toml::node* n = r.seen.at(stiff);
+      throw DeckError(one_line(r.where(stiff, n) + stiff + " = " + value_text(*n) + " and " + pen +
+                               " = " + value_text(*r.seen.at(pen)) +
+                               ": give the joint stiffness (N/m3) or the penalty, not both"));
+    }
+  }
+  if (given("contact.restitution") && c.contact.restitution < 1.0 && c.material.model != "rigid") {
+    const toml::node* n = r.seen.at("contact.restitution");
+    throw DeckError(one_line(r.where("contact.restitution", n) + "contact.restitution = " +
+                             value_text(*n) +
+                             ": impact damping needs material.model = \"rigid\" (elastic blocks "
+                             "allow only 1)"));
+  }
   if (c.model.kind == "polygons") readable("model.file", c.model.file);
   if (c.load.base.signal == "file") readable("load.base.file", c.load.base.file);
   if (given("capacity.lambda_min") && given("capacity.lambda_max") &&
@@ -628,8 +655,13 @@ Config parse_deck(const std::string& text, const std::string& source,
   config.deck_dir = r.deck_dir;
   walk(r, root, "", config);
   check_together(r, config);
-  for (const auto& [k, n] : r.seen)
+  // Rigid blocks carry no element stress: the field is not written (`check` says so).
+  if (config.material.model == "rigid")
+    std::erase(config.output.fields, std::string("stress"));
+  for (const auto& [k, n] : r.seen) {
     if (k.rfind("model.", 0) == 0) config.model.given.push_back(k.substr(6));
+    if (k.rfind("contact.", 0) == 0) config.contact.given.push_back(k.substr(8));
+  }
   return config;
 }
 

@@ -58,12 +58,14 @@ density = 450
 young = 3.5e9
 poisson = 0.25
 plane = "stress"
+model = "elastic"
 
 [contact]
 friction = 0.68
 penalty_factor = 50
 penalty = 1e12
 buffer = 0.002
+restitution = 1.0
 
 [solver]
 dt = 2e-7
@@ -165,6 +167,8 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.material.young, 3.5e9);
   EXPECT_DOUBLE_EQ(c.material.poisson, 0.25);
   EXPECT_EQ(c.material.plane, "stress");
+  EXPECT_EQ(c.material.model, "elastic");
+  EXPECT_DOUBLE_EQ(c.contact.restitution, 1.0);
   EXPECT_DOUBLE_EQ(c.contact.friction, 0.68);
   EXPECT_DOUBLE_EQ(c.contact.penalty_factor, 50.0);
   EXPECT_DOUBLE_EQ(c.contact.penalty, 1e12);
@@ -192,6 +196,26 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
 }
 
 // The full deck above exercises every key the reader knows, and nothing else.
+// The joint-stiffness keys, which the full deck cannot hold beside its penalty (one or the
+// other, test_rigid.cpp).
+const char* kJointKeys = R"(
+[model]
+kind = "block"
+[contact]
+normal_stiffness = 1e10
+shear_stiffness = 4e9
+)";
+
+TEST(Deck, JointStiffnessKeysRoundTrip) {
+  const Config c = parse_deck(kJointKeys, "joints.toml");
+  EXPECT_DOUBLE_EQ(c.contact.normal_stiffness, 1e10);
+  EXPECT_DOUBLE_EQ(c.contact.shear_stiffness, 4e9);
+  EXPECT_DOUBLE_EQ(c.contact.restitution, 1.0);
+  EXPECT_EQ(c.material.model, "elastic");
+  EXPECT_TRUE(c.contact.has("normal_stiffness"));
+  EXPECT_FALSE(c.contact.has("penalty"));
+}
+
 TEST(Deck, FullDeckCoversEveryKnownKey) {
   std::set<std::string> in_deck;
   const toml::table t = toml::parse(kFullDeck);
@@ -206,6 +230,9 @@ TEST(Deck, FullDeckCoversEveryKnownKey) {
         }
       };
   collect(t, "");
+  collect(toml::parse(kJointKeys), "");
+  in_deck.erase("model.kind");  // in both
+  in_deck.insert("model.kind");
   const std::set<std::string> known(known_keys().begin(), known_keys().end());
   EXPECT_EQ(known.size(), known_keys().size()) << "duplicate key in known_keys()";
   EXPECT_EQ(in_deck, known);

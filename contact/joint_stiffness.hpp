@@ -1,0 +1,91 @@
+#pragma once
+// Joint stiffness in engineering units and impact damping (issue 23; SPEC section 1 and the
+// `[contact]` keys normal_stiffness, shear_stiffness, restitution).
+//
+// From kn [N/m3] to a pair penalty. The potential contact force of triangles c and t is
+//     f = Ep t_z integral over the overlap of (grad phi_c - grad phi_t) dA       (narrow_phase)
+// On a dry joint the overlap is a thin strip of depth d along the two facing edges, inside the
+// sub-triangles next to those edges, where |grad phi| = 3/h (h: the triangle's height over its
+// facing edge; phi goes from 0 on the edge to 1 at the centroid, a third of the height away).
+// Both gradients point across the strip, so over a contact length L
+//     |f| = Ep t_z (3/h_c + 3/h_t) L d,
+// a normal stiffness per unit joint area of Ep (3/h_c + 3/h_t). A joint of stiffness kn thus
+// needs, for this pair,
+//     Ep_pair = kn / (3/h_c + 3/h_t).
+// The penalty stays constant for the pair's life (a function of the reference geometry only),
+// so the contact is still a potential one: its energy is honest and the ledger exact. Corner
+// contacts (a vertex pushed into a face) keep the potential's own law: the stiffness of a
+// joint is what a flat joint gives, as in UDEC and 3DEC.
+//
+// Facing edge: of c's boundary edges, the one whose outward normal points most towards t's
+// centroid, in the reference configuration (so a restart or a re-detection finds the same
+// edge). Its length L_c and c's height h_c over it; likewise for t.
+//
+// Default for rigid blocks (no stiffness given; UDEC practice of lumping the blocks'
+// elasticity into the joints): kn = E / l, with l the length of the joint's blocks normal to
+// the joint: half of each of two free blocks, l = (l_c + l_t) / 2 (each block lends half its
+// length to each of its two joints, so a column of rigid blocks is as stiff as the elastic
+// column), and the whole free block against a fixed one, l = l_c (a block alone on its support
+// lends it all). l_b is the extent of block b's outline along the facing edge's normal.
+//
+// Shear: the friction law's tangential spring (contact/friction.hpp) acts at one point of the
+// pair: kt = ks t_z min(L_c, L_t), the shear stiffness of the longest flat contact the two
+// facing edges can make; ks = kTangentialStiffnessRatio x kn when not given.
+//
+// Impact damping for a coefficient of restitution e. A body of mass m falling flat onto a
+// joint of length L bounces on the spring K = kn t_z L; a dashpot of damping ratio
+//     zeta = -ln e / sqrt(pi^2 + ln^2 e)          (zeta = 1 at e = 0)
+// returns it with e times its approach speed (the linear spring-dashpot result). The dashpot
+// acts on the rate of the pair's normal force, in the force's own direction:
+//     f_d = beta d|f|/dt  f / |f|,    beta = 2 zeta / omega,   omega^2 = kn t_z L / m_eff,
+// which on the flat joint is the dashpot c = 2 zeta sqrt(K m_eff) on the normal relative
+// velocity (d|f|/dt = K v_n), follows the actual contact when only part of the joint touches
+// (rocking), and vanishes for a rigid motion of the pair (|f| unchanged when the pair only
+// turns). m_eff = m_c m_t / (m_c + m_t) of the two blocks (m_c against a fixed block),
+// L = min of the two blocks' extents along the facing edge. The rate is the backward
+// difference (|f|^n - |f|^(n-1)) / dt, the damping at the lagging velocity, as the element
+// damping of core/cst.hpp. Its work is booked by the trapezoid over each position increment,
+// 1/2 (f_d^n + f_d^(n-1)) . (x^n - x^(n-1)), per node (contact/contact.cpp), so the ledger
+// stays exact to O(dt^2).
+
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace voussoir {
+
+// One triangle's facing edge towards a point (reference configuration).
+struct FacingEdge {
+  double length = 0.0;  // [m]
+  double height = 0.0;  // triangle height over it [m]
+  Vec2 normal;          // outward unit normal
+  Vec2 mid;             // mid-point [m]
+};
+
+// The boundary edge of triangle e whose outward normal points most towards `toward`; its
+// length is 0 when e has no boundary edge.
+FacingEdge facing_edge(const Model& model, Index e, const Vec2& toward);
+
+// Centroid of triangle e in the reference configuration.
+Vec2 reference_centroid(const Model& model, Index e);
+
+// Extent of a polygon along a unit direction (max - min of the projections) [m].
+double extent_along(const std::vector<Vec2>& polygon, const Vec2& direction);
+
+// Damping ratio of the restitution e in [0, 1] (above); 0 at e = 1.
+double restitution_damping_ratio(double e);
+
+// Mapping and damping parameters of one pair (c, t).
+struct PairJoint {
+  double kn = 0.0;     // normal stiffness [N/m3]
+  double ep = 0.0;     // pair penalty Ep_pair [Pa] (0 when the pair has no facing edge)
+  double kt = 0.0;     // tangential spring [N/m] (times the out-of-plane thickness)
+  double omega = 0.0;  // joint frequency [1/s] (above)
+};
+
+// kn_given > 0: that stiffness; else young > 0: E / l (above); else penalty mode: kn from the
+// single penalty Ep (kn = Ep (3/h_c + 3/h_t)). ks_given = 0: kTangentialStiffnessRatio x kn.
+PairJoint pair_joint(const Model& model, Index c, Index t, double kn_given, double young,
+                     double penalty, double ks_given, double thickness);
+
+}  // namespace voussoir

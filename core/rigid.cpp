@@ -1,0 +1,118 @@
+// Rigid-block stage (math in core/rigid.hpp).
+
+#include "core/rigid.hpp"
+
+#include <cmath>
+
+namespace voussoir {
+
+double triangle_polar_inertia(double rho_a, const Vec2& p0, const Vec2& p1, const Vec2& p2,
+                              const Vec2& o) {
+  const double ax = p0.x - o.x, ay = p0.y - o.y;
+  const double bx = p1.x - o.x, by = p1.y - o.y;
+  const double cx = p2.x - o.x, cy = p2.y - o.y;
+  const double area = 0.5 * std::abs((bx - ax) * (cy - ay) - (by - ay) * (cx - ax));
+  const double sum = ax * ax + ay * ay + bx * bx + by * by + cx * cx + cy * cy +
+                     (ax * bx + ay * by) + (bx * cx + by * cy) + (cx * ax + cy * ay);
+  return rho_a * area / 6.0 * sum;
+}
+
+void make_blocks_rigid(Model& model) {
+  const Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  RigidBodies& r = model.rigid;
+  const std::size_t nb = model.blocks.size();
+  for (auto* v :
+       {&r.cx, &r.cy, &r.theta, &r.vx, &r.vy, &r.omega, &r.cx0, &r.cy0, &r.mass, &r.inertia})
+    v->assign(nb, 0.0);
+  r.rx.assign(n.x.size(), 0.0);
+  r.ry.assign(n.x.size(), 0.0);
+  const double rho_a = model.material.density * model.out_of_plane;
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Block& blk = model.blocks[b];
+    // Centroid of the lumped node masses (= the area centroid of the triangles).
+    double m = 0.0, mx = 0.0, my = 0.0;
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+      m += n.mass[i];
+      mx += n.mass[i] * n.x0[i];
+      my += n.mass[i] * n.y0[i];
+    }
+    if (!(m > 0.0)) continue;
+    const Vec2 c{mx / m, my / m};
+    double inertia = 0.0;
+    for (Index e = blk.first_tri; e < blk.first_tri + blk.tri_count; ++e) {
+      const Vec2 p0{n.x0[t.n0[e]], n.y0[t.n0[e]]};
+      const Vec2 p1{n.x0[t.n1[e]], n.y0[t.n1[e]]};
+      const Vec2 p2{n.x0[t.n2[e]], n.y0[t.n2[e]]};
+      inertia += triangle_polar_inertia(rho_a, p0, p1, p2, c);
+    }
+    r.cx[b] = r.cx0[b] = c.x;
+    r.cy[b] = r.cy0[b] = c.y;
+    r.mass[b] = m;
+    r.inertia[b] = inertia;
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+      r.rx[i] = n.x0[i] - c.x;
+      r.ry[i] = n.y0[i] - c.y;
+    }
+  }
+}
+
+void set_rigid_state(Model& model, Index b, double cx, double cy, double theta, double vx,
+                     double vy, double omega) {
+  RigidBodies& r = model.rigid;
+  Nodes& n = model.nodes;
+  const Block& blk = model.blocks[std::size_t(b)];
+  r.cx[b] = cx, r.cy[b] = cy, r.theta[b] = theta;
+  r.vx[b] = vx, r.vy[b] = vy, r.omega[b] = omega;
+  const double cs = std::cos(theta), sn = std::sin(theta);
+  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+    const double ox = cs * r.rx[i] - sn * r.ry[i], oy = sn * r.rx[i] + cs * r.ry[i];
+    n.x[i] = cx + ox;
+    n.y[i] = cy + oy;
+    n.vx[i] = vx - omega * oy;
+    n.vy[i] = vy + omega * ox;
+  }
+}
+
+double integrate_rigid_bodies(Model& model, double dt) {
+  Nodes& n = model.nodes;
+  RigidBodies& r = model.rigid;
+  double twice_kinetic = 0.0;
+  const Index nb = static_cast<Index>(model.blocks.size());
+  for (Index b = 0; b < nb; ++b) {
+    const Block& blk = model.blocks[b];
+    if (blk.fixed || !(r.mass[b] > 0.0)) continue;
+    const Index begin = blk.first_node, end = blk.first_node + blk.node_count;
+    // Force and moment about the current centroid.
+    const double cx = r.cx[b], cy = r.cy[b];
+    double fx = 0.0, fy = 0.0, torque = 0.0;
+    for (Index i = begin; i < end; ++i) {
+      fx += n.fx[i];
+      fy += n.fy[i];
+      torque += (n.x[i] - cx) * n.fy[i] - (n.y[i] - cy) * n.fx[i];
+    }
+    const double ux = r.vx[b] + dt * fx / r.mass[b];
+    const double uy = r.vy[b] + dt * fy / r.mass[b];
+    const double w = r.omega[b] + dt * torque / r.inertia[b];
+    twice_kinetic += r.mass[b] * (r.vx[b] * ux + r.vy[b] * uy) + r.inertia[b] * r.omega[b] * w;
+    r.vx[b] = ux;
+    r.vy[b] = uy;
+    r.omega[b] = w;
+    r.cx[b] = cx + dt * ux;
+    r.cy[b] = cy + dt * uy;
+    r.theta[b] += dt * w;
+    const double cs = std::cos(r.theta[b]), sn = std::sin(r.theta[b]);
+    const double inv_dt = 1.0 / dt;
+    for (Index i = begin; i < end; ++i) {
+      const double x = r.cx[b] + cs * r.rx[i] - sn * r.ry[i];
+      const double y = r.cy[b] + sn * r.rx[i] + cs * r.ry[i];
+      n.vx[i] = (x - n.x[i]) * inv_dt;
+      n.vy[i] = (y - n.y[i]) * inv_dt;
+      n.x[i] = x;
+      n.y[i] = y;
+    }
+  }
+  return 0.5 * twice_kinetic;
+}
+
+}  // namespace voussoir

@@ -1,0 +1,256 @@
+// Rigid blocks and joint stiffness (core/rigid.hpp, contact/joint_stiffness.hpp; issue 23):
+// a block settles by weight / (kn area), shears by force / (ks area), rebounds to e^2 of its
+// drop height, keeps its energy balance;
+// the mass and inertia of a body; rigid rotation keeps the shape; bad keys are refused.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "core/rigid.hpp"
+#include "drivers/setup.hpp"
+#include "io/checkpoint.hpp"
+#include "io/deck.hpp"
+
+namespace voussoir {
+namespace {
+
+Simulation deck_sim(const std::string& text, const std::vector<std::string>& sets = {},
+                    SetupInfo* info = nullptr) {
+  return make_simulation(parse_deck(text, "test", sets), info);
+}
+
+// A rectangular rigid block on a fixed ground (scene "block"), 0.25 x 1 m, rho 2000.
+std::string block_deck(const std::string& contact, const std::string& safety = "0.9") {
+  return "[model]\nkind = \"block\"\nwidth = 0.25\nheight = 1.0\n"
+         "[material]\nmodel = \"rigid\"\n[solver]\ndt_safety = " +
+         safety + "\n[contact]\n" + contact + "\n";
+}
+
+Index free_block(const Model& m) {
+  for (Index b = 0; b < Index(m.blocks.size()); ++b)
+    if (!m.blocks[std::size_t(b)].fixed) return b;
+  return -1;
+}
+
+// Steps until `time` [s], returning the largest ledger balance error seen.
+template <class Each>
+double run_until(Simulation& sim, double time, Each&& each) {
+  double worst = 0.0;
+  while (sim.ctx.time < time) {
+    advance(sim);
+    worst = std::max(worst, sim.ledger.balance_error());
+    each(sim);
+  }
+  return worst;
+}
+
+TEST(Rigid, MassInertiaAndCentroidOfABlock) {
+  Simulation sim = deck_sim(block_deck("friction = 0.8"));
+  const Model& m = sim.model;
+  const Index b = free_block(m);
+  const double w = 0.25, h = 1.0, mass = 2000.0 * w * h;
+  EXPECT_NEAR(m.rigid.mass[b], mass, 1e-9 * mass);
+  EXPECT_NEAR(m.rigid.inertia[b], mass * (w * w + h * h) / 12.0, 1e-9 * mass);
+  EXPECT_NEAR(m.rigid.cx0[b], 0.0, 1e-12);
+  EXPECT_NEAR(m.rigid.cy0[b], 0.5, 1e-12);
+}
+
+TEST(Rigid, TriangleInertiaAgainstTheParallelAxisTheorem) {
+  // Right triangle legs a, b at the origin: I about the right-angle vertex = rho A (a^2+b^2)/6.
+  const double a = 0.3, b = 0.7, rho = 1500.0;
+  const double i0 = triangle_polar_inertia(rho, {0, 0}, {a, 0}, {0, b}, {0, 0});
+  EXPECT_NEAR(i0, rho * 0.5 * a * b * (a * a + b * b) / 6.0, 1e-12);
+  // About the centroid: I0 - m |g|^2.
+  const Vec2 g{a / 3.0, b / 3.0};
+  const double ic = triangle_polar_inertia(rho, {0, 0}, {a, 0}, {0, b}, g);
+  EXPECT_NEAR(ic, i0 - rho * 0.5 * a * b * (g.x * g.x + g.y * g.y), 1e-12);
+}
+
+TEST(Rigid, ABlockKeepsItsShapeWhateverItsRotation) {
+  Simulation sim = deck_sim(block_deck("friction = 0.8"));
+  Model& m = sim.model;
+  const Index b = free_block(m);
+  const Block& blk = m.blocks[std::size_t(b)];
+  set_rigid_state(m, b, 3.0, 4.0, 2.5, 0.0, 0.0, 0.0);
+  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i)
+    for (Index j = blk.first_node; j < i; ++j) {
+      const double d = std::hypot(m.nodes.x[i] - m.nodes.x[j], m.nodes.y[i] - m.nodes.y[j]);
+      const double d0 = std::hypot(m.nodes.x0[i] - m.nodes.x0[j], m.nodes.y0[i] - m.nodes.y0[j]);
+      EXPECT_NEAR(d, d0, 1e-12);
+    }
+}
+
+TEST(Rigid, FreeFlightIsExactAndConservesEnergy) {
+  // No contact reached: a spinning, thrown block follows the parabola and keeps omega.
+  Simulation sim = deck_sim(block_deck("friction = 0.8"));
+  Model& m = sim.model;
+  const Index b = free_block(m);
+  set_rigid_state(m, b, 0.0, 10.0, 0.0, 1.0, 2.0, 3.0);
+  const double worst = run_until(sim, 0.5, [](const Simulation&) {});
+  // Central differences are exact for constant acceleration; the trapezoid ledger too.
+  const double t = sim.ctx.time, g = 9.81, dt = sim.ctx.dt;
+  EXPECT_NEAR(m.rigid.cx[b], 1.0 * t, 1e-9);
+  // x^n = x0 + v^(-1/2) t + g/2 t (t + dt) for the leapfrog started from v^(-1/2) = v0.
+  EXPECT_NEAR(m.rigid.cy[b], 10.0 + 2.0 * t - 0.5 * g * t * (t + dt), 1e-9);
+  EXPECT_NEAR(m.rigid.omega[b], 3.0, 1e-12);
+  EXPECT_LT(worst, 1e-9);
+}
+
+TEST(Rigid, BlockSettlesByWeightOverNormalStiffnessTimesArea) {
+  const double kn = 1e9;  // soft, so the settlement is large against round-off
+  Simulation sim = deck_sim(block_deck("friction = 0.8\nnormal_stiffness = 1e9\nrestitution = 0"));
+  const Index b = free_block(sim.model);
+  const double worst = run_until(sim, 1.0, [](const Simulation&) {});
+  const double weight = 2000.0 * 0.25 * 1.0 * 9.81;
+  const double expected = weight / (kn * 0.25 * 1.0);
+  const double settled = sim.model.rigid.cy0[b] - sim.model.rigid.cy[b];
+  EXPECT_NEAR(settled, expected, 0.01 * expected);
+  EXPECT_LT(worst, 0.01);
+}
+
+TEST(Rigid, ShearOfTheJointGivesShearStiffness) {
+  // A horizontal load below friction shears the base joint by F / (ks area).
+  const double ks = 2e8;
+  Simulation sim = deck_sim(block_deck("friction = 5\nnormal_stiffness = 1e10\n"
+                                       "shear_stiffness = 2e8\nrestitution = 0"),
+                            {"load.lambda=0.05"});
+  const Index b = free_block(sim.model);
+  // Ramp the horizontal load to avoid an overshoot, then hold; the dashpots act normal to the
+  // joint only, so the shear mode keeps ringing: average over its last period.
+  const double lambda = 0.05, g = 9.81, ramp = 0.2;
+  double sum = 0.0, n = 0.0;
+  const double mass = 2000.0 * 0.25;
+  const double period = 2.0 * std::numbers::pi * std::sqrt(mass / (ks * 0.25));
+  const double worst = run_until(sim, 1.0, [&](Simulation& s) {
+    s.ctx.body_ax = lambda * g * std::min(1.0, s.ctx.time / ramp);
+    const RigidBodies& r = s.model.rigid;
+    // Horizontal displacement of the base mid-point (0, -h/2) from the centroid.
+    const double ux = r.cx[b] - r.cx0[b] + std::sin(r.theta[b]) * 0.5;
+    if (s.ctx.time > 1.0 - 10 * period) sum += ux, n += 1.0;
+  });
+  const double expected = lambda * mass * g / (ks * 0.25);
+  EXPECT_NEAR(sum / n, expected, 0.02 * expected);
+  EXPECT_LT(worst, 0.01);
+}
+
+// Drop from `height` [m] above the ground; returns the rebound height of the first bounce.
+double rebound_height(double restitution, double height, double* worst) {
+  // Half the default step: an impact lasts pi / omega, about 9 steps at the default one, where
+  // the lagging dashpot leaves e^2 5 to 11% high and the ledger 1.3 to 2.8% off (measured,
+  // docs/rigid.md); at half of it both are within the bounds below.
+  Simulation sim = deck_sim(block_deck(
+      "friction = 0.8\nnormal_stiffness = 1e10\nrestitution = " + std::to_string(restitution),
+      "0.45"));
+  Model& m = sim.model;
+  const Index b = free_block(m);
+  const double rest_y = m.rigid.cy0[b];
+  set_rigid_state(m, b, m.rigid.cx0[b], rest_y + height, 0.0, 0.0, 0.0, 0.0);
+  bool touched = false, left = false;
+  double peak = -1.0;
+  *worst = run_until(sim, 2.0 * std::sqrt(2.0 * height / 9.81) + 0.05, [&](Simulation& s) {
+    const double y = s.model.rigid.cy[b] - rest_y;
+    if (s.contact.active_pairs() > 0) touched = true;
+    if (touched && s.contact.active_pairs() == 0) left = true;
+    if (left) peak = std::max(peak, y);
+  });
+  return peak;
+}
+
+TEST(Rigid, DroppedBlockReboundsToRestitutionSquaredOfItsHeight) {
+  for (const double e : {0.5, 0.8}) {
+    double worst = 0.0;
+    const double h = 0.01;
+    const double up = rebound_height(e, h, &worst);
+    EXPECT_NEAR(up / h, e * e, 0.05 * e * e) << "restitution " << e;
+    EXPECT_LT(worst, 0.01) << "restitution " << e;
+  }
+}
+
+TEST(Rigid, RestartContinuesBitForBit) {
+  // A rocking block with impact damping: 400 steps straight, or 150, a checkpoint, a fresh
+  // simulation restored from it and 250 more.
+  const std::string deck = block_deck("friction = 0.8\nnormal_stiffness = 1e10\nrestitution = 0.3");
+  auto tilt = [](Simulation& s) {
+    const Index b = free_block(s.model);
+    set_rigid_state(s.model, b, 0.0, 0.51, 0.05, 0.0, 0.0, 0.0);
+  };
+  Simulation straight = deck_sim(deck);
+  tilt(straight);
+  for (int k = 0; k < 400; ++k) advance(straight);
+  Simulation first = deck_sim(deck);
+  tilt(first);
+  for (int k = 0; k < 150; ++k) advance(first);
+  const std::string path = ::testing::TempDir() + "rigid_restart.ckpt";
+  write_checkpoint(path, first, simulation_fingerprint(first, 0.8), 0.8, {});
+  Simulation second = deck_sim(deck);
+  read_checkpoint(path, second, simulation_fingerprint(second, 0.8));
+  for (int k = 0; k < 250; ++k) advance(second);
+  EXPECT_EQ(second.model.nodes.x, straight.model.nodes.x);
+  EXPECT_EQ(second.model.nodes.y, straight.model.nodes.y);
+  EXPECT_EQ(second.model.rigid.theta, straight.model.rigid.theta);
+  EXPECT_EQ(second.ledger.impact_dissipated, straight.ledger.impact_dissipated);
+  EXPECT_GT(straight.ledger.impact_dissipated, 0.0);
+}
+
+TEST(Rigid, NoStressFieldForRigidBlocks) {
+  const Config c = parse_deck(block_deck("friction = 0.8"), "test");
+  EXPECT_EQ(c.output.fields, (std::vector<std::string>{"position", "velocity"}));
+}
+
+TEST(Rigid, RestingBlockEnergyBalanceWithoutDamping) {
+  // No impact damping: the block bounces on its joint, grazing the ground at each period,
+  // the hardest case for the ledger (core/rigid.hpp kRigidStepFraction).
+  Simulation sim = deck_sim(block_deck("friction = 0.8"));
+  const double worst = run_until(sim, 1.0, [](const Simulation&) {});
+  EXPECT_LT(worst, 0.01);
+}
+
+TEST(Rigid, StableStepIsSetByTheJointsNotTheElements) {
+  SetupInfo elastic, rigid;
+  const std::string arch =
+      "[model]\nkind = \"circular_arch\"\nradius = 1\nthickness = 0.2\nembrace = 180\n"
+      "voussoirs = 11\n";
+  deck_sim(arch, {}, &elastic);
+  deck_sim(arch, {"material.model=rigid"}, &rigid);
+  EXPECT_GT(rigid.dt, 5.0 * elastic.dt);
+  // kn sets it: a 100 x stiffer joint, a 10 x shorter step.
+  SetupInfo stiff;
+  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e12"}, &stiff);
+  SetupInfo stiffer;
+  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e14"}, &stiffer);
+  EXPECT_NEAR(stiff.dt / stiffer.dt, 10.0, 0.01);
+}
+
+void expect_refused(const std::string& text, const std::vector<std::string>& sets,
+                    const std::vector<std::string>& words) {
+  try {
+    parse_deck(text, "test", sets);
+    ADD_FAILURE() << "accepted";
+  } catch (const DeckError& e) {
+    const std::string what = e.what();
+    for (const std::string& w : words) EXPECT_NE(what.find(w), std::string::npos) << what;
+  }
+}
+
+TEST(Rigid, BadKeysAreRefusedNamingKeyValueAndWhatIsAllowed) {
+  const std::string deck = block_deck("friction = 0.8");
+  expect_refused(deck, {"material.model=plastic"}, {"material.model", "plastic", "rigid"});
+  expect_refused(deck, {"contact.normal_stiffness=0"}, {"contact.normal_stiffness", "0", "> 0"});
+  expect_refused(deck, {"contact.shear_stiffness=-1e9"}, {"contact.shear_stiffness", "-1e+09"});
+  expect_refused(deck, {"contact.normal_stiffness=1e10", "contact.penalty=1e12"},
+                 {"contact.normal_stiffness", "contact.penalty", "not both"});
+  expect_refused(deck, {"contact.shear_stiffness=1e10", "contact.penalty_factor=10"},
+                 {"contact.shear_stiffness", "contact.penalty_factor"});
+  expect_refused(deck, {"contact.restitution=1.5"}, {"contact.restitution", "1.5"});
+  expect_refused(deck, {"contact.restitution=-0.1"}, {"contact.restitution"});
+  expect_refused(deck, {"material.model=elastic", "contact.restitution=0.5"},
+                 {"contact.restitution", "rigid"});
+}
+
+}  // namespace
+}  // namespace voussoir
