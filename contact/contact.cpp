@@ -804,7 +804,7 @@ ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) c
     if (!(kn > 0.0) && s.params.joint_young > 0.0) {
       const double lb = extent_along(blk.polygon, normal);
       const double l = partner_free ? 0.5 * (lb + extent_along(other->polygon, normal)) : lb;
-      kn = s.params.joint_young / l;
+      kn = kRigidJointFactor * s.params.joint_young / l;
     } else if (!(kn > 0.0)) {
       // Penalty mode: Ep (3/h_b + 3/h_partner) with the smallest face heights.
       const double hb = s.block_min_height[std::size_t(b)];

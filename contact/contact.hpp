@@ -18,8 +18,8 @@ struct ContactParams {
   double buffer = 0.0;    // NBS buffer [m]; 0 = automatic (a fraction of the smallest element)
   // Joint stiffness in engineering units (contact/joint_stiffness.hpp). normal_stiffness kn
   // [N/m3] > 0 replaces the single penalty by one per pair that gives kn on a flat joint;
-  // joint_young E [Pa] > 0 (and kn = 0) takes kn = E / l per pair instead (the rigid-block
-  // default). shear_stiffness ks [N/m3]: tangential spring of the friction law; 0 = 1/4 of the
+  // joint_young E [Pa] > 0 (and kn = 0) takes kn = 100 E / l per pair instead (the rigid-block
+  // default, contact/joint_stiffness.hpp). shear_stiffness ks [N/m3]: tangential spring of the friction law; 0 = 1/4 of the
   // normal stiffness (kTangentialStiffnessRatio).
   double normal_stiffness = 0.0;
   double joint_young = 0.0;

@@ -11,42 +11,6 @@
 
 namespace voussoir {
 
-Vec2 reference_centroid(const Model& model, Index e) {
-  const Nodes& n = model.nodes;
-  const Triangles& t = model.tris;
-  return {(n.x0[t.n0[e]] + n.x0[t.n1[e]] + n.x0[t.n2[e]]) / 3.0,
-          (n.y0[t.n0[e]] + n.y0[t.n1[e]] + n.y0[t.n2[e]]) / 3.0};
-}
-
-FacingEdge facing_edge(const Model& model, Index e, const Vec2& toward) {
-  const Nodes& n = model.nodes;
-  const Triangles& t = model.tris;
-  const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
-  const Vec2 g = reference_centroid(model, e);
-  double dx = toward.x - g.x, dy = toward.y - g.y;
-  const double dl = std::hypot(dx, dy);
-  if (dl > 0.0) dx /= dl, dy /= dl;
-  FacingEdge best;
-  double best_dot = -std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 3; ++k) {
-    if (!(t.boundary[e] & (1u << k))) continue;
-    const Index i0 = v[k], i1 = v[(k + 1) % 3];
-    const double ex = n.x0[i1] - n.x0[i0], ey = n.y0[i1] - n.y0[i0];
-    const double len = std::hypot(ex, ey);
-    if (!(len > 0.0)) continue;
-    const Vec2 normal{ey / len, -ex / len};  // outward for a counter-clockwise triangle
-    const double dot = normal.x * dx + normal.y * dy;
-    if (dot > best_dot) {
-      best_dot = dot;
-      best.length = len;
-      best.height = 2.0 * t.area0[e] / len;
-      best.normal = normal;
-      best.mid = {0.5 * (n.x0[i0] + n.x0[i1]), 0.5 * (n.y0[i0] + n.y0[i1])};
-    }
-  }
-  return best;
-}
-
 double extent_along(const std::vector<Vec2>& polygon, const Vec2& d) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Vec2& p : polygon) {
@@ -64,11 +28,67 @@ double restitution_damping_ratio(double e) {
   return -l / std::sqrt(std::numbers::pi * std::numbers::pi + l * l);
 }
 
+namespace {
+
+// The boundary edges of triangle e in the reference configuration.
+std::vector<std::pair<Vec2, Vec2>> boundary_edges(const Model& model, Index e) {
+  const Nodes& n = model.nodes;
+  const Triangles& t = model.tris;
+  const Index v[3] = {t.n0[e], t.n1[e], t.n2[e]};
+  std::vector<std::pair<Vec2, Vec2>> out;
+  for (int k = 0; k < 3; ++k)
+    if (t.boundary[e] & (1u << k))
+      out.push_back({{n.x0[v[k]], n.y0[v[k]]}, {n.x0[v[(k + 1) % 3]], n.y0[v[(k + 1) % 3]]}});
+  return out;
+}
+
+double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double l2 = dx * dx + dy * dy;
+  const double s =
+      l2 > 0.0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / l2, 0.0, 1.0) : 0.0;
+  return std::hypot(p.x - a.x - s * dx, p.y - a.y - s * dy);
+}
+
+FacingEdge edge_of(const Model& model, Index e, const std::pair<Vec2, Vec2>& edge) {
+  FacingEdge f;
+  const double ex = edge.second.x - edge.first.x, ey = edge.second.y - edge.first.y;
+  f.length = std::hypot(ex, ey);
+  f.height = 2.0 * model.tris.area0[e] / f.length;
+  f.normal = {ey / f.length, -ex / f.length};
+  f.mid = {0.5 * (edge.first.x + edge.second.x), 0.5 * (edge.first.y + edge.second.y)};
+  return f;
+}
+
+}  // namespace
+
+// Facing edges of a pair: of the boundary edges of c and of t, the two that lie closest to
+// each other (segment distance), the most nearly opposite normals breaking ties (a joint's two
+// faces touch along their length with opposite normals; a face and the side that meets it at a
+// corner touch only at that corner and are not opposite).
+std::pair<FacingEdge, FacingEdge> facing_edges(const Model& model, Index c, Index t) {
+  const auto ec = boundary_edges(model, c), et = boundary_edges(model, t);
+  std::pair<FacingEdge, FacingEdge> best;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (const auto& a : ec)
+    for (const auto& b : et) {
+      const FacingEdge fa = edge_of(model, c, a), fb = edge_of(model, t, b);
+      if (!(fa.length > 0.0) || !(fb.length > 0.0)) continue;
+      const double dist = std::min({point_segment_distance(a.first, b.first, b.second),
+                                    point_segment_distance(a.second, b.first, b.second),
+                                    point_segment_distance(b.first, a.first, a.second),
+                                    point_segment_distance(b.second, a.first, a.second)});
+      const double opposite = 1.0 + fa.normal.x * fb.normal.x + fa.normal.y * fb.normal.y;
+      const double score = dist + 1e-3 * std::max(fa.length, fb.length) * opposite;
+      if (score < best_score) best_score = score, best = {fa, fb};
+    }
+  return best;
+}
+
 PairJoint pair_joint(const Model& model, Index c, Index t, double kn_given, double young,
                      double penalty, double ks_given, double thickness) {
   PairJoint r;
-  const FacingEdge fc = facing_edge(model, c, reference_centroid(model, t));
-  const FacingEdge ft = facing_edge(model, t, reference_centroid(model, c));
+  const auto [fc, ft] = facing_edges(model, c, t);
   if (!(fc.length > 0.0) || !(ft.length > 0.0)) return r;
   const Block& bc = model.blocks[model.tris.block[c]];
   const Block& bt = model.blocks[model.tris.block[t]];
@@ -80,7 +100,7 @@ PairJoint pair_joint(const Model& model, Index c, Index t, double kn_given, doub
     const double lt = extent_along(bt.polygon, fc.normal);
     double l = 0.5 * (lc + lt);
     if (bc.fixed != bt.fixed) l = bc.fixed ? lt : lc;
-    r.kn = young / l;
+    r.kn = kRigidJointFactor * young / l;
   } else {
     r.kn = penalty * g;
   }

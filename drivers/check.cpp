@@ -93,7 +93,7 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                   config.contact.shear_stiffness > 0.0 ? config.contact.shear_stiffness
                                                        : 0.25 * config.contact.normal_stiffness);
     else
-      std::printf("joints      kn = E / l per joint (l: the blocks' length normal to it), ks = %s\n",
+      std::printf("joints      kn = 100 E / l per joint (l: the blocks' length normal to it), ks = %s\n",
                   config.contact.shear_stiffness > 0.0 ? "contact.shear_stiffness" : "kn / 4");
   } else {
     std::printf("penalty     %.4g Pa\n", info.penalty);

@@ -6,6 +6,7 @@
 #include "core/cst.hpp"
 #include "core/rigid.hpp"
 #include "io/deck.hpp"
+#include "mesh/minimal.hpp"
 #include "mesh/scene.hpp"
 
 namespace voussoir {
@@ -27,7 +28,11 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   Simulation sim;
   sim.model = build_model(config);
   const bool rigid = config.material.model == "rigid";
-  if (rigid) make_blocks_rigid(sim.model);
+  if (rigid) {
+    // Only the outline matters to a rigid block: the fewest triangles (mesh/minimal.hpp).
+    sim.model = minimal_model(sim.model, config.mesh.chord_tolerance);
+    make_blocks_rigid(sim.model);
+  }
   ContactParams cp;
   cp.penalty = contact_penalty(config);
   cp.friction = config.contact.friction;
@@ -35,7 +40,7 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   cp.normal_stiffness = config.contact.normal_stiffness;
   cp.shear_stiffness = config.contact.shear_stiffness;
   cp.restitution = config.contact.restitution;
-  // Rigid blocks with neither a stiffness nor a penalty given: kn = E / l per joint
+  // Rigid blocks with neither a stiffness nor a penalty given: kn = 100 E / l per joint
   // (contact/joint_stiffness.hpp).
   if (rigid && !(cp.normal_stiffness > 0.0) && !config.contact.has("penalty") &&
       !config.contact.has("penalty_factor"))

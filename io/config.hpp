@@ -42,6 +42,9 @@ struct ModelConfig {
 struct MeshConfig {
   double size = 0.0;                   // target element size [m]; 0 = use through_thickness
   int through_thickness = 1;           // elements across the thickness (arches)
+  // Rigid blocks (mesh/minimal.hpp): an outline point goes when the chord replacing it stays
+  // within this fraction of the block's thickness of the outline.
+  double chord_tolerance = 0.01;
 };
 
 struct MaterialConfig {
@@ -58,7 +61,7 @@ struct ContactConfig {
   double penalty = 0.0;                // Ep [Pa]; 0 = use penalty_factor
   double buffer = 0.0;                 // NBS buffer [m]; 0 = automatic
   // Joint stiffness [N/m3] (contact/joint_stiffness.hpp); 0 = not given: the penalty for
-  // elastic blocks, kn = E / l for rigid ones; shear 0 = 1/4 of the normal stiffness.
+  // elastic blocks, kn = 100 E / l for rigid ones; shear 0 = 1/4 of the normal stiffness.
   double normal_stiffness = 0.0;
   double shear_stiffness = 0.0;
   double restitution = 1.0;            // impact restitution in [0, 1]; 1 = no impact damping

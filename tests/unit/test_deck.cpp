@@ -52,6 +52,7 @@ out_of_plane = 0.092
 [mesh]
 size = 0.05
 through_thickness = 3
+chord_tolerance = 0.02
 
 [material]
 density = 450
@@ -163,6 +164,7 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_TRUE(m.has("model.embrace"));
   EXPECT_DOUBLE_EQ(c.mesh.size, 0.05);
   EXPECT_EQ(c.mesh.through_thickness, 3);
+  EXPECT_DOUBLE_EQ(c.mesh.chord_tolerance, 0.02);
   EXPECT_DOUBLE_EQ(c.material.density, 450.0);
   EXPECT_DOUBLE_EQ(c.material.young, 3.5e9);
   EXPECT_DOUBLE_EQ(c.material.poisson, 0.25);

@@ -15,6 +15,7 @@
 #include "drivers/setup.hpp"
 #include "io/checkpoint.hpp"
 #include "io/deck.hpp"
+#include "mesh/minimal.hpp"
 
 namespace voussoir {
 namespace {
@@ -202,6 +203,80 @@ TEST(Rigid, NoStressFieldForRigidBlocks) {
   EXPECT_EQ(c.output.fields, (std::vector<std::string>{"position", "velocity"}));
 }
 
+TEST(MinimalMesh, StraightSidesLoseTheirMidPointsAndAQuadGetsTwoTriangles) {
+  // A 2 x 1 rectangle with nodes every 0.25 along its sides.
+  std::vector<Vec2> outline;
+  for (int k = 0; k < 8; ++k) outline.push_back({0.25 * k, 0.0});
+  for (int k = 0; k < 4; ++k) outline.push_back({2.0, 0.25 * k});
+  for (int k = 8; k > 0; --k) outline.push_back({0.25 * k, 1.0});
+  for (int k = 4; k > 0; --k) outline.push_back({0.0, 0.25 * k});
+  const std::vector<Vec2> s = simplify_outline(outline, 0.01);
+  ASSERT_EQ(s.size(), 4u);
+  EXPECT_EQ(ear_clip(s).size(), 2u);
+}
+
+TEST(MinimalMesh, AnArcKeepsThePointsItsSagittaAsksFor) {
+  // Voussoir 0.2 thick, 16 degrees of a unit circle, intrados and extrados with 8 points each.
+  std::vector<Vec2> outline;
+  const double a0 = 0.0, a1 = 16.0 * std::numbers::pi / 180.0;
+  for (int k = 0; k <= 8; ++k) {
+    const double a = a0 + (a1 - a0) * k / 8;
+    outline.push_back({0.9 * std::cos(a), 0.9 * std::sin(a)});
+  }
+  for (int k = 8; k >= 0; --k) {
+    const double a = a0 + (a1 - a0) * k / 8;
+    outline.push_back({1.1 * std::cos(a), 1.1 * std::sin(a)});
+  }
+  std::reverse(outline.begin(), outline.end());  // counter-clockwise
+  // Sagitta of the whole extrados chord: 1.1 (1 - cos 8 deg) = 0.0107, 5.4% of 0.2.
+  EXPECT_EQ(simplify_outline(outline, 0.1).size(), 4u);
+  const std::vector<Vec2> fine = simplify_outline(outline, 0.01);
+  EXPECT_GT(fine.size(), 4u);
+  // Every original point within 1% of the thickness of the simplified outline.
+  for (const Vec2& p : outline) {
+    double d = 1e9;
+    for (std::size_t k = 0; k < fine.size(); ++k) {
+      const Vec2 &a = fine[k], &b = fine[(k + 1) % fine.size()];
+      const double dx = b.x - a.x, dy = b.y - a.y;
+      const double t =
+          std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+      d = std::min(d, std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy));
+    }
+    EXPECT_LE(d, 0.01 * 0.2 + 1e-12);
+  }
+  EXPECT_EQ(ear_clip(fine).size(), fine.size() - 2);
+}
+
+TEST(MinimalMesh, NonConvexBlockTriangulatesWithoutOverlap) {
+  // A crown block with a notch in its intrados.
+  const std::vector<Vec2> poly = {{-1, 0}, {0, 0.3}, {1, 0}, {1, 1}, {-1, 1}};
+  const auto tris = ear_clip(poly);
+  ASSERT_EQ(tris.size(), 3u);
+  double area = 0.0;
+  for (const auto& t : tris) {
+    const Vec2 &a = poly[t[0]], &b = poly[t[1]], &c = poly[t[2]];
+    const double cr = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    EXPECT_GT(cr, 0.0);
+    area += 0.5 * cr;
+  }
+  EXPECT_NEAR(area, 2.0 - 0.3, 1e-12);  // 2 x 1 rectangle less the notch triangle
+}
+
+TEST(MinimalMesh, RigidShippedDecksKeepMassAndJoints) {
+  for (const char* deck : {"circular_arch", "church_b", "block"}) {
+    const Config c = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/" + deck + ".toml");
+    Simulation elastic = make_simulation(c);
+    Config r = c;
+    r.material.model = "rigid";
+    r.output.fields = {"position"};
+    Simulation rigid = make_simulation(r);
+    EXPECT_LT(rigid.model.tris.size(), elastic.model.tris.size()) << deck;
+    EXPECT_EQ(rigid.model.joints.size(), elastic.model.joints.size()) << deck;
+    EXPECT_NEAR(free_mass(rigid.model), free_mass(elastic.model), 0.01 * free_mass(elastic.model))
+        << deck;
+  }
+}
+
 TEST(Rigid, RestingBlockEnergyBalanceWithoutDamping) {
   // No impact damping: the block bounces on its joint, grazing the ground at each period,
   // the hardest case for the ledger (core/rigid.hpp kRigidStepFraction).
@@ -211,19 +286,19 @@ TEST(Rigid, RestingBlockEnergyBalanceWithoutDamping) {
 }
 
 TEST(Rigid, StableStepIsSetByTheJointsNotTheElements) {
-  SetupInfo elastic, rigid;
+  SetupInfo elastic, soft, stiff, stiffer;
   const std::string arch =
       "[model]\nkind = \"circular_arch\"\nradius = 1\nthickness = 0.2\nembrace = 180\n"
       "voussoirs = 11\n";
   deck_sim(arch, {}, &elastic);
-  deck_sim(arch, {"material.model=rigid"}, &rigid);
-  EXPECT_GT(rigid.dt, 5.0 * elastic.dt);
+  // Engineering joints (1e10 N/m3) against the elements and penalty of elastic blocks.
+  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e10"}, &soft);
+  EXPECT_GT(soft.dt, 10.0 * elastic.dt);
   // kn sets it: a 100 x stiffer joint, a 10 x shorter step.
-  SetupInfo stiff;
   deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e12"}, &stiff);
-  SetupInfo stiffer;
   deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e14"}, &stiffer);
   EXPECT_NEAR(stiff.dt / stiffer.dt, 10.0, 0.01);
+  EXPECT_NE(soft.dt_set_by.find("rigid"), std::string::npos);
 }
 
 void expect_refused(const std::string& text, const std::vector<std::string>& sets,
