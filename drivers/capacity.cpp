@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -13,29 +14,13 @@
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/trial.hpp"
 #include "limit/limit_analysis.hpp"
 
 namespace voussoir {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// Largest centroid displacement [m] and rotation [rad] of the free blocks since `base`.
-struct MotionExtent {
-  double displacement = 0.0, rotation = 0.0;
-};
-
-MotionExtent largest_motion(const Model& model, const std::vector<BlockMotion>& base) {
-  const std::vector<BlockMotion> now = block_motions(model);
-  MotionExtent m;
-  for (size_t b = 0; b < now.size(); ++b) {
-    if (model.blocks[b].fixed) continue;
-    m.displacement =
-        std::max(m.displacement, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
-    m.rotation = std::max(m.rotation, std::abs(now[b].rotation - base[b].rotation));
-  }
-  return m;
-}
 
 }  // namespace
 
@@ -46,38 +31,33 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
   Simulation& sim = s.sim;
-  const double dt = sim.ctx.dt;
-  const long long every = std::max(1LL, std::llround(kSampleTime / dt));
   const double v_rest = crit.rest_speed * std::sqrt(std::max(s.gravity, 1e-12) * s.l_ref);
   const double d_collapse = crit.collapse_displacement * s.l_ref;
-  const std::vector<BlockMotion> start = block_motions(sim.model);
-  RestDetector rest(v_rest, crit.hold_time);
-  ProgressTicker progress(quiet);
-  while (sim.ctx.time < crit.settle_max_time) {
-    const double ramp = std::min(1.0, sim.ctx.time / crit.ramp_time);
-    set_static_load(sim, s.gravity * ramp, 0.0);
-    advance(sim);
-    if (sim.step % every != 0) continue;
-    check_finite(sim);
-    const MotionExtent moved = largest_motion(sim.model, start);
-    s.max_displacement = moved.displacement;
-    s.max_rotation = moved.rotation;
-    if (progress.due())
-      std::fprintf(stderr,
-                   "  settling: %.3f s simulated, largest block motion %.3g m, %.3g rad, speed "
-                   "%.2g x the rest speed (%.0f s wall)\n",
-                   sim.ctx.time, moved.displacement, moved.rotation,
-                   max_free_speed(sim.model.nodes) / v_rest, progress.wall());
-    if (moved.displacement > d_collapse || moved.rotation > crit.collapse_rotation) {
-      s.collapsed = true;  // no need to wait for the time limit
-      break;
-    }
-    if (sim.ctx.time < crit.ramp_time) continue;
-    if (rest.update(sim.ctx.time, max_free_speed(sim.model.nodes), sim.ledger.kinetic)) {
-      s.settled = true;
-      break;
-    }
-  }
+
+  // Gravity ramped on, no horizontal load; ends at rest, at a collapse (no need to wait for the
+  // time limit) or at settle_max_time.
+  RunSpec spec;
+  spec.label = "the settle under gravity";
+  spec.loads = LoadProgram{};
+  spec.loads->gravity = s.gravity;
+  spec.loads->gravity_ramp = crit.ramp_time;
+  spec.limits = crit.limits;
+  spec.end_time = crit.settle_max_time;
+  spec.track_motion = true;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time));
+  spec.quiet = quiet;
+  spec.progress = [&](const Probe& p, double wall) {
+    std::fprintf(stderr,
+                 "  settling: %.3f s simulated, largest block motion %.3g m, %.3g rad, speed "
+                 "%.2g x the rest speed (%.0f s wall)\n",
+                 p.time, p.motion.displacement, p.motion.rotation, p.speed / v_rest, wall);
+  };
+  const Outcome o = run_engine(sim, spec);
+  s.settled = o.decided && !o.collapsed;
+  s.collapsed = o.decided && o.collapsed;
+  s.max_displacement = o.motion.displacement;
+  s.max_rotation = o.motion.rotation;
   set_static_load(sim, s.gravity, 0.0);
   s.settle_time = sim.ctx.time;
   s.steps = sim.step;
@@ -111,66 +91,46 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   const auto t0 = Clock::now();
   Simulation sim = settled.sim;  // deep copy
   const double g = settled.gravity;
-  const double t_start = sim.ctx.time;
-  const long long step_start = sim.step;
-  const long long every = std::max(1LL, std::llround(kSampleTime / sim.ctx.dt));
   const double v_rest = crit.rest_speed * std::sqrt(std::max(g, 1e-12) * settled.l_ref);
   const double d_collapse = crit.collapse_displacement * settled.l_ref;
-  // Motions are measured from the settled state: re-reference the block centroids there.
-  const std::vector<BlockMotion> base = block_motions(sim.model);
+
+  // lambda g ramped on from the settled state; motions measured from there. Collapse at any
+  // time; rest and the trend at the time limit once the ramp is over.
+  char label[64];
+  std::snprintf(label, sizeof label, "the capacity trial lambda = %.6g", lambda);
+  RunSpec spec;
+  spec.label = label;
+  spec.loads = LoadProgram{};
+  spec.loads->gravity = g;
+  spec.loads->lambda = lambda;
+  spec.loads->lambda_ramp = crit.ramp_time;
+  spec.loads->start = sim.ctx.time;
+  spec.limits = crit.limits;
+  spec.track_motion = true;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time));
+  spec.rules.push_back(std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0,
+                                                   crit.ramp_time, crit.max_time));
+  spec.quiet = quiet;
+  spec.progress = [&](const Probe& p, double wall) {
+    std::fprintf(stderr,
+                 "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
+                 "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
+                 lambda, p.time,
+                 100.0 * std::max(p.motion.displacement / d_collapse,
+                                  p.motion.rotation / crit.collapse_rotation),
+                 p.speed / v_rest, wall);
+  };
+  const Outcome o = run_engine(sim, spec);
 
   TrialResult r;
   r.lambda = lambda;
-  RestDetector rest(v_rest, crit.hold_time);
-  ProgressTicker progress(quiet);
-  // Motion measure m(t) = max over blocks of max(d / d_collapse, |rotation| / rot_collapse)
-  // (1 = collapse) sampled in time, for the timeout decision.
-  std::vector<double> measure;
-  bool decided = false;
-  while (!decided) {
-    const double t = sim.ctx.time - t_start;
-    set_static_load(sim, g, lambda * std::min(1.0, t / crit.ramp_time));
-    advance(sim);
-    if ((sim.step - step_start) % every != 0) continue;
-    check_finite(sim);
-    const double elapsed = sim.ctx.time - t_start;
-    const MotionExtent moved = largest_motion(sim.model, base);
-    const double dmax = moved.displacement, rmax = moved.rotation;
-    r.max_displacement = dmax;
-    r.max_rotation = rmax;
-    measure.push_back(std::max(dmax / d_collapse, rmax / crit.collapse_rotation));
-    if (progress.due())
-      std::fprintf(stderr,
-                   "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
-                   "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
-                   lambda, elapsed, 100.0 * measure.back(),
-                   max_free_speed(sim.model.nodes) / v_rest, progress.wall());
-    if (dmax > d_collapse || rmax > crit.collapse_rotation) {
-      r.collapsed = true;
-      r.reason = dmax > d_collapse ? "displacement" : "rotation";
-      decided = true;
-    } else if (elapsed >= crit.ramp_time) {
-      const double v = max_free_speed(sim.model.nodes);
-      if (rest.update(elapsed, v, sim.ledger.kinetic)) {
-        r.reason = "rest";
-        decided = true;
-      }
-      if (!decided && elapsed >= crit.max_time) {
-        // Near lambda* the restoring stiffness of the mechanism vanishes, so motion decays
-        // ever more slowly (critical slowing down) and neither criterion fires. Decide by the
-        // trend: collapsed when the motion measure now exceeds by 10% its largest value over
-        // the first two thirds of the trial (a mechanism that keeps opening), stable when it
-        // stays bounded (an oscillation about a displaced equilibrium).
-        const size_t cut = measure.size() * 2 / 3;
-        const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
-        r.collapsed = measure.back() > 1.1 * earlier;
-        r.reason = "timeout";
-        decided = true;
-      }
-    }
-  }
-  r.sim_time = sim.ctx.time - t_start;
-  r.steps = sim.step - step_start;
+  r.collapsed = o.collapsed;
+  r.reason = o.reason;
+  r.max_displacement = o.motion.displacement;
+  r.max_rotation = o.motion.rotation;
+  r.sim_time = o.time;
+  r.steps = o.steps;
   r.energy_balance_error = sim.ledger.balance_error();
   if (r.collapsed) {
     const double tol = kHingeFraction * settled.l_ref;
@@ -369,13 +329,23 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       }
     }
     const int n = static_cast<int>(todo.size());
+    // A failed trial (RunError from the engine's guards) may not leave the parallel region:
+    // kept, and the first one in input order thrown after it.
+    std::vector<std::exception_ptr> failed(lambdas.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, std::min(n, omp_get_max_threads())))
     for (int k = 0; k < n; ++k) {
       const int i = todo[k];
-      out[i] = run_trial(settled, lambdas[i], crit, quiet);
+      try {
+        out[i] = run_trial(settled, lambdas[i], crit, quiet);
+      } catch (...) {
+        failed[i] = std::current_exception();
+        continue;
+      }
 #pragma omp critical(voussoir_journal)
       journal.append(out[i]);
     }
+    for (const std::exception_ptr& e : failed)
+      if (e) std::rethrow_exception(e);
     for (size_t i = 0; i < out.size(); ++i) {
       const bool resumed = std::find(todo.begin(), todo.end(), int(i)) == todo.end();
       report(out[i], quiet, resumed);

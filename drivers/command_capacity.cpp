@@ -29,7 +29,8 @@ nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
 
 int command_capacity(const Config& config, const CommonOptions& common,
                      const CapacityOptions& opts) {
-  const TrialCriteria& criteria = opts.criteria;
+  TrialCriteria criteria = opts.criteria;
+  criteria.limits = common.limits;
   CapacitySearch search;
   search.points = opts.points;
   search.quiet = common.quiet;

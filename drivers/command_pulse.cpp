@@ -64,7 +64,8 @@ SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {
 
 int single_run(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
   const auto wall0 = Clock::now();
-  const PulseCriteria crit;
+  PulseCriteria crit;
+  crit.settle.limits = common.limits;
   const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
   if (signal.kind() == BaseSignal::Kind::None)
     throw DeckError(config.deck_path +
@@ -197,7 +198,8 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
                     "\": pulse --curve needs an analytic pulse (windowed_sine or sine_pulse)");
   if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
     throw DeckError("pulse --tolerance " + std::to_string(opts.tolerance) + " must lie in (0, 1)");
-  const PulseCriteria crit;
+  PulseCriteria crit;
+  crit.settle.limits = common.limits;
 
   double lambda_star = opts.lambda_star;
   double capacity_wall = 0.0;

@@ -57,6 +57,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   const StabilityGrid grid = make_stability_grid(deck_path, sets, axes);
   StabilityCriteria crit;
   crit.ke_time = opts.ke_time;
+  crit.trial.limits = common.limits;
   crit.trial.max_time = opts.max_time;
   if (!common.quiet)
     std::fprintf(stderr,
@@ -159,6 +160,8 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
       "analysis, %d failed; written to %s (%.1f s wall)\n",
       cells.size(), n_stable, cells.size() - n_stable - n_error, n_disagree, n_error,
       csv_path.c_str(), wall);
+  for (const StabilityCell& r : cells)
+    if (!r.error.empty()) std::fprintf(stderr, "voussoir: run failed: %s\n", r.error.c_str());
   if (!common.json_path.empty()) {
     nlohmann::json jaxes = nlohmann::json::array();
     for (const StabilityAxis& a : axes) {

@@ -69,7 +69,8 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
 
   std::vector<CapacityResult> results(cells);
   std::vector<std::string> errors(cells);
-  const TrialCriteria& criteria = opts.criteria;
+  TrialCriteria criteria = opts.criteria;
+  criteria.limits = common.limits;
   // Resume: the journal holds one JSON line per finished cell ({"cell": i, "values": [...],
   // result}); cells found there with the same values are not run again.
   std::vector<bool> finished(cells, false);

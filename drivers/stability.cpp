@@ -17,6 +17,7 @@
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/trial.hpp"
 #include "io/deck.hpp"
 #include "limit/limit_analysis.hpp"
 #include "mesh/scene.hpp"
@@ -135,7 +136,7 @@ double stability_ke_length(const Config& config, const Model& model) {
 }
 
 StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& crit,
-                                 bool keep_mode) {
+                                 bool keep_mode, const std::string& cell_label) {
   const auto t0 = Clock::now();
   Config config = deck;
   config.load.lambda = 0.0;  // gravity only
@@ -155,60 +156,38 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   c.ke_length = stability_ke_length(config, sim.model);
   const double g = config.load.gravity;
   const double ke_scale = c.free_mass * g * c.ke_length;
-  const long long every = std::max(1LL, std::llround(kSampleTime / sim.ctx.dt));
   const double v_rest = tc.rest_speed * std::sqrt(std::max(g, 1e-12) * c.l_ref);
   const double d_collapse = tc.collapse_displacement * c.l_ref;
-  const std::vector<BlockMotion> base = block_motions(sim.model);  // rest, unloaded
 
-  std::vector<double> measure;  // motion measure per sample (1 = collapse threshold)
-  RestDetector rest(v_rest, tc.hold_time);
-  bool decided = false, ke_read = false;
-  while (!(decided && ke_read)) {
-    const double t = sim.ctx.time;
-    set_static_load(sim, g * std::min(1.0, t / tc.ramp_time), 0.0);
-    advance(sim);
-    if (sim.step % every != 0) continue;
-    check_finite(sim);
-    const double now = sim.ctx.time;
-    const std::vector<BlockMotion> m = block_motions(sim.model);
-    double dmax = 0.0, rmax = 0.0;
-    for (size_t b = 0; b < m.size(); ++b) {
-      if (sim.model.blocks[b].fixed) continue;
-      dmax = std::max(dmax, std::hypot(m[b].ux - base[b].ux, m[b].uy - base[b].uy));
-      rmax = std::max(rmax, std::abs(m[b].rotation - base[b].rotation));
-    }
-    c.max_displacement = dmax;
-    c.max_rotation = rmax;
-    if (!ke_read && now >= crit.ke_time) {
-      c.kinetic_energy = sim.ledger.kinetic;
-      c.ke_read_time = now;
+  // Gravity ramped on from rest; motions measured from the unloaded geometry. A decided cell
+  // runs on to ke_time, when its kinetic energy is read.
+  RunSpec spec;
+  spec.label = "the stability cell " + cell_label;
+  spec.loads = LoadProgram{};
+  spec.loads->gravity = g;
+  spec.loads->gravity_ramp = tc.ramp_time;
+  spec.limits = tc.limits;
+  spec.track_motion = true;
+  spec.min_time = crit.ke_time;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, tc.collapse_rotation));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, tc.hold_time, tc.ramp_time));
+  spec.rules.push_back(
+      std::make_unique<TrendRule>(d_collapse, tc.collapse_rotation, 0.0, tc.ramp_time, tc.max_time));
+  bool ke_read = false;
+  spec.on_sample = [&](const Simulation& s, const Probe& p) {
+    if (!ke_read && p.time >= crit.ke_time) {
+      c.kinetic_energy = s.ledger.kinetic;
+      c.ke_read_time = p.time;
       ke_read = true;
     }
-    if (decided) continue;
-    measure.push_back(std::max(dmax / d_collapse, rmax / tc.collapse_rotation));
-    if (dmax > d_collapse || rmax > tc.collapse_rotation) {
-      c.stable = false;
-      c.reason = dmax > d_collapse ? "displacement" : "rotation";
-      decided = true;
-    } else if (now >= tc.ramp_time) {
-      if (rest.update(now, max_free_speed(sim.model.nodes), sim.ledger.kinetic)) {
-        c.stable = true;
-        c.reason = "rest";
-        decided = true;
-      }
-      if (!decided && now >= tc.max_time) {
-        // Critical slowing down near the threshold: decide by the trend, as capacity does
-        // (drivers/capacity.cpp): collapsed when the motion measure now exceeds by 10% its
-        // largest value over the first two thirds of the run.
-        const size_t cut = measure.size() * 2 / 3;
-        const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
-        c.stable = !(measure.back() > 1.1 * earlier);
-        c.reason = "timeout";
-        decided = true;
-      }
-    }
-    if (decided) c.decision_time = now;
-  }
+    return true;
+  };
+  const Outcome o = run_engine(sim, spec);
+  c.stable = !o.collapsed;
+  c.reason = o.reason;
+  c.decision_time = o.decided_at;
+  c.max_displacement = o.motion.displacement;
+  c.max_rotation = o.motion.rotation;
   c.normalised_ke = ke_scale > 0.0 ? c.kinetic_energy / ke_scale : 0.0;
   c.sim_time = sim.ctx.time;
   c.steps = sim.step;
@@ -301,7 +280,10 @@ std::vector<StabilityCell> run_stability_map(const StabilityGrid& grid,
   for (long c = 0; c < cells; ++c) {
     StabilityCell& r = out[c];
     try {
-      r = run_stability_cell(grid.configs[c], crit, keep_modes);
+      std::string label;
+      for (size_t k = 0; k < grid.axes.size(); ++k)
+        label += (k ? " " : "") + grid.axes[k].key + "=" + grid.values[c][k];
+      r = run_stability_cell(grid.configs[c], crit, keep_modes, label);
       if (r.stable) {  // outlines are only wanted for collapse modes
         r.outlines.clear();
         r.outlines0.clear();

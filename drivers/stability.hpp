@@ -105,9 +105,10 @@ struct StabilityCell {
 double stability_ke_length(const Config& config, const Model& model);
 
 // Runs one cell (the deck as given, lambda and base motion ignored); `keep_mode` keeps the
-// block outlines at the end. Throws RunError on a non-finite state.
+// block outlines at the end. Throws RunError from the engine's guards (non-finite state,
+// energy balance), naming the cell by `cell_label` (its --param values).
 StabilityCell run_stability_cell(const Config& config, const StabilityCriteria& criteria,
-                                 bool keep_mode);
+                                 bool keep_mode, const std::string& cell_label = "");
 
 // The limit-analysis cross-check of one cell (fills la_admissible and la_status). GLPK is not
 // assumed thread-safe: call it outside parallel regions.
