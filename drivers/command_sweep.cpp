@@ -175,9 +175,13 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
       std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
                    opts.plot.c_str());
   }
+  int failed = 0;
   for (const std::string& e : errors)
-    if (!e.empty()) return 1;
-  return 0;
+    if (!e.empty()) {
+      std::fprintf(stderr, "voussoir: run failed: %s\n", e.c_str());
+      ++failed;
+    }
+  return failed > 0 ? 1 : 0;
 }
 
 }  // namespace voussoir
