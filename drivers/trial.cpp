@@ -82,17 +82,42 @@ class EnergyGuard : public StopRule {
   const std::string& label_;
 };
 
+// --max-steps: a budget per run (each settle, trial, pulse run, stability cell or `run`),
+// counted from the run's start and read at its samples, so a run fails at its first sample
+// at or past max_steps steps.
+class MaxStepsGuard : public StopRule {
+ public:
+  MaxStepsGuard(long long max_steps, const std::string& label)
+      : max_steps_(max_steps), label_(label) {}
+  std::optional<Verdict> check(const Probe& p) override {
+    if (max_steps_ <= 0 || p.steps < max_steps_) return std::nullopt;
+    std::ostringstream msg;
+    msg << "step limit --max-steps " << max_steps_ << " reached " << where(p.sim, -1, label_)
+        << " after " << p.steps << " steps of this run";
+    throw RunError(msg.str());
+  }
+
+ private:
+  long long max_steps_;
+  const std::string& label_;
+};
+
 // The guards every run has, built from its limits, read before the classification rules.
 std::vector<std::unique_ptr<StopRule>> make_guards(const RunSpec& spec) {
   std::vector<std::unique_ptr<StopRule>> guards;
   guards.push_back(std::make_unique<FiniteGuard>(spec.label));
   guards.push_back(std::make_unique<EnergyGuard>(spec.limits, spec.label));
+  guards.push_back(std::make_unique<MaxStepsGuard>(spec.limits.max_steps, spec.label));
   return guards;
 }
 
 }  // namespace
 
-void add_limit_options(CLI::App* cmd, RunLimits& limits) { (void)cmd, (void)limits; }
+void add_limit_options(CLI::App* cmd, RunLimits& limits) {
+  cmd->add_option("--max-steps", limits.max_steps,
+                  "fail a run (each settle, trial, pulse run or cell) still going after N steps")
+      ->check(CLI::PositiveNumber);
+}
 
 void LoadProgram::apply(Simulation& sim) const {
   const double t = sim.ctx.time - start;
@@ -158,10 +183,14 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
   double next_progress = spec.progress_period;
 
   Outcome out;
-  auto probe_now = [&] {
+  auto clock_probe = [&] {  // time and steps only: what the guards read
     Probe p(sim);
     p.time = sim.ctx.time - t_start;
     p.steps = sim.step - step_start;
+    return p;
+  };
+  auto probe_now = [&] {
+    Probe p = clock_probe();
     if (spec.track_motion) p.motion = largest_motion(sim.model, base);
     p.speed = max_free_speed(sim.model.nodes);
     return p;
@@ -184,10 +213,10 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
       // The last step of a run that ends off the sample grid is still guarded.
       const bool ends = info.last || !(sim.ctx.time - t_start < spec.end_time);
       if (ends)
-        for (auto& g : guards) g->check(Probe(sim));
+        for (auto& g : guards) g->check(clock_probe());
       continue;
     }
-    for (auto& g : guards) g->check(Probe(sim));
+    for (auto& g : guards) g->check(clock_probe());
     const Probe p = probe_now();
     out.sample_time = p.time;
     out.motion = p.motion;

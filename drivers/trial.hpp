@@ -144,6 +144,7 @@ class TrendRule : public StopRule {
 struct RunLimits {
   double drift_limit = kEnergyDriftLimit;            // <= 0: energy guard off
   long long drift_arm_steps = kEnergyDriftArmSteps;  // energy guard from this absolute step on
+  long long max_steps = 0;  // --max-steps N: a run still going after N steps fails; 0 = none
 };
 
 // The engine's options for every command that runs (run, capacity, sweep, pulse, stability).

@@ -69,6 +69,33 @@ TEST(EngineGuards, NonFiniteForceStopsAStabilityCell) {
                     "the stability cell load.gravity=1e300");
 }
 
+TEST(EngineLimits, MaxStepsStopsEveryClassifiedCommand) {
+  // --max-steps 500: the settle of the block (about 64000 steps) is the first run to pass it.
+  const std::string csv = (fs::temp_directory_path() / "voussoir_engine_steps.csv").string();
+  const std::vector<std::vector<std::string>> commands = {
+      {"run", case_path("block"), "--set", "solver.end_time=0.01"},
+      {"capacity", case_path("block")},
+      {"pulse", case_path("block"), "--set", "load.base.signal=windowed_sine", "--set",
+       "load.base.frequency=4"},
+      {"stability", case_path("block"), "--param", "contact.friction=0.6", "--csv", csv},
+      {"sweep", case_path("block"), "--param", "contact.friction=0.6", "--csv", csv}};
+  for (std::vector<std::string> args : commands) {
+    const std::string name = args[0];
+    args.insert(args.end(), {"--max-steps", "500", "-q"});
+    const testing::ProcessResult r = run_voussoir("steps_" + name, args);
+    ASSERT_TRUE(r.exited) << name << ": " << r.describe();
+    EXPECT_EQ(r.status, 1) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("--max-steps 500 reached in "), std::string::npos)
+        << name << ": " << r.err;
+    EXPECT_NE(r.err.find("(t = "), std::string::npos) << name << ": " << r.err;
+  }
+  // Far above what the run needs: no effect.
+  const testing::ProcessResult ok =
+      run_voussoir("steps_ok", {"run", case_path("block"), "--set", "solver.end_time=0.01",
+                                "--max-steps", "100000", "-q"});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 TEST(LoadProgram, RampsAndSignalFromTheSimulationTime) {
   Simulation sim = make_simulation(load_deck(case_path("block"), {}));
   const BaseSignal signal = BaseSignal::one_sine(2.0, 1.0);  // 2 m/s2 at 1 Hz
