@@ -11,6 +11,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "core/fnv.hpp"
+#include "drivers/journal.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
@@ -151,29 +153,18 @@ void report(const TrialResult& r, bool quiet, bool resumed) {
                r.steps, r.wall_s, resumed ? " [journal]" : "");
 }
 
-// FNV-1a over bytes: the journal's fingerprint of a settled state and the trial criteria.
-struct Fingerprint {
-  std::uint64_t h = 1469598103934665603ull;
-  void add(const void* data, size_t n) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
-  }
-  void add(double v) { add(&v, sizeof v); }
-};
-
+// The journal's fingerprint (core/fnv.hpp) of a settled state and the trial criteria.
 std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
-  Fingerprint f;
+  Fnv f;
   const Nodes& n = s.sim.model.nodes;
-  f.add(n.x.data(), n.x.size() * sizeof(double));
-  f.add(n.y.data(), n.y.size() * sizeof(double));
-  f.add(n.vx.data(), n.vx.size() * sizeof(double));
-  f.add(n.vy.data(), n.vy.size() * sizeof(double));
+  f.array(n.x);
+  f.array(n.y);
+  f.array(n.vx);
+  f.array(n.vy);
   for (double v : {s.sim.ctx.dt, s.sim.ctx.eta, s.gravity, c.ramp_time, c.collapse_displacement,
                    c.collapse_rotation, c.rest_speed, c.hold_time, c.max_time})
-    f.add(v);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(f.h));
-  return buf;
+    f.value(v);
+  return f.hex();
 }
 
 nlohmann::json trial_json(const TrialResult& r) {
@@ -211,54 +202,13 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   return r;
 }
 
-// Finished trials on disk, one JSON object a line after a header line with the fingerprint.
-// Lambdas are written with 17 significant digits, so a resumed search that recomputes the
-// same lambdas finds them bit for bit. A journal of another state is refused, never mixed.
-class Journal {
- public:
-  Journal(const std::string& path, const std::string& print) : path_(path) {
-    if (path_.empty()) return;
-    std::ifstream in(path_);
-    std::string line;
-    if (in && std::getline(in, line)) {
-      const auto head = nlohmann::json::parse(line, nullptr, false);
-      if (head.is_discarded() || head.value("fingerprint", "") != print)
-        throw RunError("journal " + path_ +
-                       " belongs to another deck or settings (fingerprint differs): remove it "
-                       "or give another --resume file");
-      while (std::getline(in, line)) {
-        const auto j = nlohmann::json::parse(line, nullptr, false);
-        if (j.is_discarded()) break;  // a line cut by the kill: the trial is run again
-        const TrialResult r = trial_from_json(j);
-        done_.emplace_back(r);
-      }
-      in.close();
-      // Rewrite without a possibly cut last line.
-      std::ofstream out(path_, std::ios::trunc);
-      out << nlohmann::json{{"fingerprint", print}}.dump() << '\n';
-      for (const TrialResult& r : done_) out << trial_json(r).dump() << '\n';
-    } else {
-      std::ofstream out(path_, std::ios::trunc);
-      if (!out) throw RunError("cannot write the journal " + path_);
-      out << nlohmann::json{{"fingerprint", print}}.dump() << '\n';
-    }
-  }
-  const TrialResult* find(double lambda) const {
-    for (const TrialResult& r : done_)
-      if (r.lambda == lambda) return &r;
-    return nullptr;
-  }
-  void append(const TrialResult& r) {
-    if (path_.empty()) return;
-    std::ofstream out(path_, std::ios::app);
-    out << trial_json(r).dump() << '\n';
-    out.flush();
-  }
-
- private:
-  std::string path_;
-  std::vector<TrialResult> done_;
-};
+// A finished trial of the journal with this lambda (written with 17 significant digits, so a
+// resumed search that recomputes the same lambdas finds them bit for bit), or null.
+const nlohmann::json* find_trial(const Journal& journal, double lambda) {
+  for (const nlohmann::json& j : journal.records())
+    if (j.contains("lambda") && j.at("lambda").get<double>() == lambda) return &j;
+  return nullptr;
+}
 
 }  // namespace
 
@@ -321,8 +271,8 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     std::vector<TrialResult> out(lambdas.size());
     std::vector<int> todo;
     for (size_t i = 0; i < lambdas.size(); ++i) {
-      if (const TrialResult* r = journal.find(lambdas[i])) {
-        out[i] = *r;
+      if (const nlohmann::json* j = find_trial(journal, lambdas[i])) {
+        out[i] = trial_from_json(*j);
         ++res.resumed_trials;
       } else {
         todo.push_back(static_cast<int>(i));
@@ -342,7 +292,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
         continue;
       }
 #pragma omp critical(voussoir_journal)
-      journal.append(out[i]);
+      journal.append(trial_json(out[i]));
     }
     for (const std::exception_ptr& e : failed)
       if (e) std::rethrow_exception(e);

@@ -52,9 +52,9 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
     throw DeckError("stability needs at least one --param KEY=V1,V2,... or KEY=start:stop:step");
   if (!(opts.ke_time > 0.0) || !(opts.max_time > 0.0))
     throw DeckError("--ke-time and --max-time must be positive seconds");
-  std::vector<StabilityAxis> axes;
-  for (const std::string& p : opts.params) axes.push_back(parse_stability_param(p));
-  const StabilityGrid grid = make_stability_grid(deck_path, sets, axes);
+  std::vector<GridAxis> axes;
+  for (const std::string& p : opts.params) axes.push_back(parse_grid_param(p));
+  const Grid grid = make_grid(deck_path, sets, axes);
   StabilityCriteria crit;
   crit.ke_time = opts.ke_time;
   crit.trial.limits = common.limits;
@@ -73,7 +73,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   std::ofstream csv(csv_path + ".tmp");
   if (!csv) throw OutputError("cannot write " + csv_path);
   csv.precision(10);
-  for (const StabilityAxis& a : axes) csv << a.key << ',';
+  for (const GridAxis& a : axes) csv << a.key << ',';
   csv << "thickness,radius,friction,stable,reason,kinetic_energy,normalised_ke,ke_time,"
          "ke_length,free_mass,max_displacement,max_rotation,decision_time,sim_time,steps,"
          "triangles,dt,wall_s,la_admissible,disagree,error\n";
@@ -164,7 +164,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
     if (!r.error.empty()) std::fprintf(stderr, "voussoir: run failed: %s\n", r.error.c_str());
   if (!common.json_path.empty()) {
     nlohmann::json jaxes = nlohmann::json::array();
-    for (const StabilityAxis& a : axes) {
+    for (const GridAxis& a : axes) {
       nlohmann::json vals = nlohmann::json::array();
       for (const std::string& v : a.values) vals.push_back(param_value(v));
       jaxes.push_back({{"key", a.key}, {"values", vals}});
