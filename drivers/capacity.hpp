@@ -32,7 +32,7 @@
 #include "core/step.hpp"
 #include "drivers/kinematics.hpp"
 #include "drivers/trial.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 

@@ -11,7 +11,7 @@
 #include "core/model.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/kinematics.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 

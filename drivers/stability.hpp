@@ -41,7 +41,7 @@
 #include "drivers/commands.hpp"
 #include "drivers/grid.hpp"
 #include "drivers/kinematics.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 
