@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drivers/commands.hpp"
+#include "drivers/plot.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
@@ -269,11 +270,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
                 p.bracketed ? "" : "  (no collapse up to the cap)");
   std::printf("curve %s; %.1f s wall in all\n", csv_path.c_str(), wall);
   if (!opts.plot.empty()) {
-    const std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
-                            "/scripts/plot_curve '" + csv_path + "' -o '" + opts.plot + "'";
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
-                   opts.plot.c_str());
+    draw_with_script("plot_curve", {csv_path, "-o", opts.plot}, opts.plot);
   }
 
   if (!common.json_path.empty()) {

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drivers/commands.hpp"
+#include "drivers/plot.hpp"
 #include "drivers/stability.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
@@ -186,13 +187,9 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
                common.json_path);
   }
   if (!opts.plot.empty()) {
-    std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
-                      "/scripts/plot_stability '" + csv_path + "' -o '" + opts.plot + "'";
-    if (keep_modes) cmd += " --modes '" + opts.mode_out + "'";
-    std::fflush(stdout);  // our summary before the script's table
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
-                   opts.plot.c_str());
+    std::vector<std::string> args = {csv_path, "-o", opts.plot};
+    if (keep_modes) args.insert(args.end(), {"--modes", opts.mode_out});
+    draw_with_script("plot_stability", args, opts.plot);
   }
   return n_error > 0 ? 1 : 0;
 }

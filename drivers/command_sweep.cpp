@@ -13,6 +13,7 @@
 #include "core/fnv.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/plot.hpp"
 #include "drivers/grid.hpp"
 #include "drivers/journal.hpp"
 #include "drivers/setup.hpp"
@@ -135,11 +136,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   if (!common.json_path.empty())
     write_json({{"cells", jcells}, {"csv", csv_path}, {"wall_s", wall}}, common.json_path);
   if (!opts.plot.empty()) {
-    const std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
-                            "/scripts/plot_sweep '" + csv_path + "' -o '" + opts.plot + "'";
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
-                   opts.plot.c_str());
+    draw_with_script("plot_sweep", {csv_path, "-o", opts.plot}, opts.plot);
   }
   int failed = 0;
   for (const std::string& e : errors)

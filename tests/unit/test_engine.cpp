@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/plot.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/trial.hpp"
 #include "io/deck.hpp"
@@ -115,6 +116,12 @@ TEST(LoadProgram, RampsAndSignalFromTheSimulationTime) {
   p.apply(sim);
   EXPECT_DOUBLE_EQ(sim.ctx.body_ay, -10.0);
   EXPECT_DOUBLE_EQ(sim.ctx.body_ax, 2.0);
+}
+
+TEST(Plot, AFailedScriptIsAWarningNotAnError) {
+  // drivers/plot.hpp: a script that fails (here: one that does not exist) returns false and
+  // says so on stderr; nothing is thrown, so the command's exit status stays that of its result.
+  EXPECT_FALSE(draw_with_script("no_such_script", {"a.csv", "-o", "a.png"}, "a.png"));
 }
 
 }  // namespace
