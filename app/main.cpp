@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
   voussoir::RunOptions run_opts;
   CLI::App* run = app.add_subcommand("run", "one simulation: HDF5 output and JSON summary");
   add_common(run, deck, common);
+  voussoir::add_limit_options(run, common.limits);
   run->add_option("-o,--output", run_opts.output, "HDF5 output file (overrides output.file)");
   run->add_option("--checkpoint-every", run_opts.checkpoint_every,
                   "write a checkpoint every T seconds of simulated time (and at the end)")
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
   CLI::App* capacity =
       app.add_subcommand("capacity", "collapse load factor lambda* by bisection on lambda");
   add_common(capacity, deck, common);
+  voussoir::add_limit_options(capacity, common.limits);
   capacity->add_option("--points", cap_opts.points,
                        "trial lambdas per bisection round, run in parallel (default 2)")
       ->check(CLI::Range(1, 64));
@@ -114,6 +116,7 @@ int main(int argc, char** argv) {
   CLI::App* pulse = app.add_subcommand(
       "pulse", "base-excitation run; --curve: collapse amplitude per frequency (failure curve)");
   add_common(pulse, deck, common);
+  voussoir::add_limit_options(pulse, common.limits);
   pulse->add_option("-o,--output", pulse_opts.output, "HDF5 output file (overrides output.file)");
   pulse->add_option("--series", pulse_opts.series,
                     "CSV time series of the run (input, energy, control points)");
@@ -132,6 +135,7 @@ int main(int argc, char** argv) {
   voussoir::SweepOptions sweep_opts;
   CLI::App* sweep = app.add_subcommand("sweep", "capacity over a grid of deck values");
   add_common(sweep, deck, common);
+  voussoir::add_limit_options(sweep, common.limits);
   sweep->add_option("--param", sweep_opts.params, "KEY=V1,V2,... (repeat for a grid)")
       ->required();
   sweep->add_option("--csv", sweep_opts.csv, "CSV output (default sweep.csv)");
@@ -149,6 +153,7 @@ int main(int argc, char** argv) {
   CLI::App* stability = app.add_subcommand(
       "stability", "gravity-only stability map over a grid (kinetic-energy criterion)");
   add_common(stability, deck, common);
+  voussoir::add_limit_options(stability, common.limits);
   stability->add_option("--param", stab_opts.params,
                         "KEY=V1,V2,... or KEY=start:stop:step (repeat for a grid); "
                         "model.thickness_ratio=R sets model.thickness = R x model.radius")

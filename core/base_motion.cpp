@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "io/deck.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 

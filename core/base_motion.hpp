@@ -58,7 +58,7 @@
 #include <string>
 #include <vector>
 
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 

@@ -6,36 +6,23 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "core/fnv.hpp"
+#include "drivers/journal.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/trial.hpp"
 #include "limit/limit_analysis.hpp"
 
 namespace voussoir {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// Largest centroid displacement [m] and rotation [rad] of the free blocks since `base`.
-struct MotionExtent {
-  double displacement = 0.0, rotation = 0.0;
-};
-
-MotionExtent largest_motion(const Model& model, const std::vector<BlockMotion>& base) {
-  const std::vector<BlockMotion> now = block_motions(model);
-  MotionExtent m;
-  for (size_t b = 0; b < now.size(); ++b) {
-    if (model.blocks[b].fixed) continue;
-    m.displacement =
-        std::max(m.displacement, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
-    m.rotation = std::max(m.rotation, std::abs(now[b].rotation - base[b].rotation));
-  }
-  return m;
-}
 
 }  // namespace
 
@@ -46,38 +33,33 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
   Simulation& sim = s.sim;
-  const double dt = sim.ctx.dt;
-  const long long every = std::max(1LL, std::llround(kSampleTime / dt));
   const double v_rest = crit.rest_speed * std::sqrt(std::max(s.gravity, 1e-12) * s.l_ref);
   const double d_collapse = crit.collapse_displacement * s.l_ref;
-  const std::vector<BlockMotion> start = block_motions(sim.model);
-  RestDetector rest(v_rest, crit.hold_time);
-  ProgressTicker progress(quiet);
-  while (sim.ctx.time < crit.settle_max_time) {
-    const double ramp = std::min(1.0, sim.ctx.time / crit.ramp_time);
-    set_static_load(sim, s.gravity * ramp, 0.0);
-    advance(sim);
-    if (sim.step % every != 0) continue;
-    check_finite(sim);
-    const MotionExtent moved = largest_motion(sim.model, start);
-    s.max_displacement = moved.displacement;
-    s.max_rotation = moved.rotation;
-    if (progress.due())
-      std::fprintf(stderr,
-                   "  settling: %.3f s simulated, largest block motion %.3g m, %.3g rad, speed "
-                   "%.2g x the rest speed (%.0f s wall)\n",
-                   sim.ctx.time, moved.displacement, moved.rotation,
-                   max_free_speed(sim.model.nodes) / v_rest, progress.wall());
-    if (moved.displacement > d_collapse || moved.rotation > crit.collapse_rotation) {
-      s.collapsed = true;  // no need to wait for the time limit
-      break;
-    }
-    if (sim.ctx.time < crit.ramp_time) continue;
-    if (rest.update(sim.ctx.time, max_free_speed(sim.model.nodes), sim.ledger.kinetic)) {
-      s.settled = true;
-      break;
-    }
-  }
+
+  // Gravity ramped on, no horizontal load; ends at rest, at a collapse (no need to wait for the
+  // time limit) or at settle_max_time.
+  RunSpec spec;
+  spec.label = "the settle under gravity";
+  spec.loads = LoadProgram{};
+  spec.loads->gravity = s.gravity;
+  spec.loads->gravity_ramp = crit.ramp_time;
+  spec.limits = crit.limits;
+  spec.end_time = crit.settle_max_time;
+  spec.track_motion = true;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time));
+  spec.quiet = quiet;
+  spec.progress = [&](const Probe& p, double wall) {
+    std::fprintf(stderr,
+                 "  settling: %.3f s simulated, largest block motion %.3g m, %.3g rad, speed "
+                 "%.2g x the rest speed (%.0f s wall)\n",
+                 p.time, p.motion.displacement, p.motion.rotation, p.speed / v_rest, wall);
+  };
+  const Outcome o = run_engine(sim, spec);
+  s.settled = o.decided && !o.collapsed;
+  s.collapsed = o.decided && o.collapsed;
+  s.max_displacement = o.motion.displacement;
+  s.max_rotation = o.motion.rotation;
   set_static_load(sim, s.gravity, 0.0);
   s.settle_time = sim.ctx.time;
   s.steps = sim.step;
@@ -111,66 +93,46 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   const auto t0 = Clock::now();
   Simulation sim = settled.sim;  // deep copy
   const double g = settled.gravity;
-  const double t_start = sim.ctx.time;
-  const long long step_start = sim.step;
-  const long long every = std::max(1LL, std::llround(kSampleTime / sim.ctx.dt));
   const double v_rest = crit.rest_speed * std::sqrt(std::max(g, 1e-12) * settled.l_ref);
   const double d_collapse = crit.collapse_displacement * settled.l_ref;
-  // Motions are measured from the settled state: re-reference the block centroids there.
-  const std::vector<BlockMotion> base = block_motions(sim.model);
+
+  // lambda g ramped on from the settled state; motions measured from there. Collapse at any
+  // time; rest and the trend at the time limit once the ramp is over.
+  char label[64];
+  std::snprintf(label, sizeof label, "the capacity trial lambda = %.6g", lambda);
+  RunSpec spec;
+  spec.label = label;
+  spec.loads = LoadProgram{};
+  spec.loads->gravity = g;
+  spec.loads->lambda = lambda;
+  spec.loads->lambda_ramp = crit.ramp_time;
+  spec.loads->start = sim.ctx.time;
+  spec.limits = crit.limits;
+  spec.track_motion = true;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time));
+  spec.rules.push_back(std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0,
+                                                   crit.ramp_time, crit.max_time));
+  spec.quiet = quiet;
+  spec.progress = [&](const Probe& p, double wall) {
+    std::fprintf(stderr,
+                 "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
+                 "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
+                 lambda, p.time,
+                 100.0 * std::max(p.motion.displacement / d_collapse,
+                                  p.motion.rotation / crit.collapse_rotation),
+                 p.speed / v_rest, wall);
+  };
+  const Outcome o = run_engine(sim, spec);
 
   TrialResult r;
   r.lambda = lambda;
-  RestDetector rest(v_rest, crit.hold_time);
-  ProgressTicker progress(quiet);
-  // Motion measure m(t) = max over blocks of max(d / d_collapse, |rotation| / rot_collapse)
-  // (1 = collapse) sampled in time, for the timeout decision.
-  std::vector<double> measure;
-  bool decided = false;
-  while (!decided) {
-    const double t = sim.ctx.time - t_start;
-    set_static_load(sim, g, lambda * std::min(1.0, t / crit.ramp_time));
-    advance(sim);
-    if ((sim.step - step_start) % every != 0) continue;
-    check_finite(sim);
-    const double elapsed = sim.ctx.time - t_start;
-    const MotionExtent moved = largest_motion(sim.model, base);
-    const double dmax = moved.displacement, rmax = moved.rotation;
-    r.max_displacement = dmax;
-    r.max_rotation = rmax;
-    measure.push_back(std::max(dmax / d_collapse, rmax / crit.collapse_rotation));
-    if (progress.due())
-      std::fprintf(stderr,
-                   "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
-                   "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
-                   lambda, elapsed, 100.0 * measure.back(),
-                   max_free_speed(sim.model.nodes) / v_rest, progress.wall());
-    if (dmax > d_collapse || rmax > crit.collapse_rotation) {
-      r.collapsed = true;
-      r.reason = dmax > d_collapse ? "displacement" : "rotation";
-      decided = true;
-    } else if (elapsed >= crit.ramp_time) {
-      const double v = max_free_speed(sim.model.nodes);
-      if (rest.update(elapsed, v, sim.ledger.kinetic)) {
-        r.reason = "rest";
-        decided = true;
-      }
-      if (!decided && elapsed >= crit.max_time) {
-        // Near lambda* the restoring stiffness of the mechanism vanishes, so motion decays
-        // ever more slowly (critical slowing down) and neither criterion fires. Decide by the
-        // trend: collapsed when the motion measure now exceeds by 10% its largest value over
-        // the first two thirds of the trial (a mechanism that keeps opening), stable when it
-        // stays bounded (an oscillation about a displaced equilibrium).
-        const size_t cut = measure.size() * 2 / 3;
-        const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
-        r.collapsed = measure.back() > 1.1 * earlier;
-        r.reason = "timeout";
-        decided = true;
-      }
-    }
-  }
-  r.sim_time = sim.ctx.time - t_start;
-  r.steps = sim.step - step_start;
+  r.collapsed = o.collapsed;
+  r.reason = o.reason;
+  r.max_displacement = o.motion.displacement;
+  r.max_rotation = o.motion.rotation;
+  r.sim_time = o.time;
+  r.steps = o.steps;
   r.energy_balance_error = sim.ledger.balance_error();
   if (r.collapsed) {
     const double tol = kHingeFraction * settled.l_ref;
@@ -191,29 +153,18 @@ void report(const TrialResult& r, bool quiet, bool resumed) {
                r.steps, r.wall_s, resumed ? " [journal]" : "");
 }
 
-// FNV-1a over bytes: the journal's fingerprint of a settled state and the trial criteria.
-struct Fingerprint {
-  std::uint64_t h = 1469598103934665603ull;
-  void add(const void* data, size_t n) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
-  }
-  void add(double v) { add(&v, sizeof v); }
-};
-
+// The journal's fingerprint (core/fnv.hpp) of a settled state and the trial criteria.
 std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
-  Fingerprint f;
+  Fnv f;
   const Nodes& n = s.sim.model.nodes;
-  f.add(n.x.data(), n.x.size() * sizeof(double));
-  f.add(n.y.data(), n.y.size() * sizeof(double));
-  f.add(n.vx.data(), n.vx.size() * sizeof(double));
-  f.add(n.vy.data(), n.vy.size() * sizeof(double));
+  f.array(n.x);
+  f.array(n.y);
+  f.array(n.vx);
+  f.array(n.vy);
   for (double v : {s.sim.ctx.dt, s.sim.ctx.eta, s.gravity, c.ramp_time, c.collapse_displacement,
                    c.collapse_rotation, c.rest_speed, c.hold_time, c.max_time})
-    f.add(v);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(f.h));
-  return buf;
+    f.value(v);
+  return f.hex();
 }
 
 nlohmann::json trial_json(const TrialResult& r) {
@@ -251,54 +202,13 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   return r;
 }
 
-// Finished trials on disk, one JSON object a line after a header line with the fingerprint.
-// Lambdas are written with 17 significant digits, so a resumed search that recomputes the
-// same lambdas finds them bit for bit. A journal of another state is refused, never mixed.
-class Journal {
- public:
-  Journal(const std::string& path, const std::string& print) : path_(path) {
-    if (path_.empty()) return;
-    std::ifstream in(path_);
-    std::string line;
-    if (in && std::getline(in, line)) {
-      const auto head = nlohmann::json::parse(line, nullptr, false);
-      if (head.is_discarded() || head.value("fingerprint", "") != print)
-        throw RunError("journal " + path_ +
-                       " belongs to another deck or settings (fingerprint differs): remove it "
-                       "or give another --resume file");
-      while (std::getline(in, line)) {
-        const auto j = nlohmann::json::parse(line, nullptr, false);
-        if (j.is_discarded()) break;  // a line cut by the kill: the trial is run again
-        const TrialResult r = trial_from_json(j);
-        done_.emplace_back(r);
-      }
-      in.close();
-      // Rewrite without a possibly cut last line.
-      std::ofstream out(path_, std::ios::trunc);
-      out << nlohmann::json{{"fingerprint", print}}.dump() << '\n';
-      for (const TrialResult& r : done_) out << trial_json(r).dump() << '\n';
-    } else {
-      std::ofstream out(path_, std::ios::trunc);
-      if (!out) throw RunError("cannot write the journal " + path_);
-      out << nlohmann::json{{"fingerprint", print}}.dump() << '\n';
-    }
-  }
-  const TrialResult* find(double lambda) const {
-    for (const TrialResult& r : done_)
-      if (r.lambda == lambda) return &r;
-    return nullptr;
-  }
-  void append(const TrialResult& r) {
-    if (path_.empty()) return;
-    std::ofstream out(path_, std::ios::app);
-    out << trial_json(r).dump() << '\n';
-    out.flush();
-  }
-
- private:
-  std::string path_;
-  std::vector<TrialResult> done_;
-};
+// A finished trial of the journal with this lambda (written with 17 significant digits, so a
+// resumed search that recomputes the same lambdas finds them bit for bit), or null.
+const nlohmann::json* find_trial(const Journal& journal, double lambda) {
+  for (const nlohmann::json& j : journal.records())
+    if (j.contains("lambda") && j.at("lambda").get<double>() == lambda) return &j;
+  return nullptr;
+}
 
 }  // namespace
 
@@ -361,21 +271,31 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     std::vector<TrialResult> out(lambdas.size());
     std::vector<int> todo;
     for (size_t i = 0; i < lambdas.size(); ++i) {
-      if (const TrialResult* r = journal.find(lambdas[i])) {
-        out[i] = *r;
+      if (const nlohmann::json* j = find_trial(journal, lambdas[i])) {
+        out[i] = trial_from_json(*j);
         ++res.resumed_trials;
       } else {
         todo.push_back(static_cast<int>(i));
       }
     }
     const int n = static_cast<int>(todo.size());
+    // A failed trial (RunError from the engine's guards) may not leave the parallel region:
+    // kept, and the first one in input order thrown after it.
+    std::vector<std::exception_ptr> failed(lambdas.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, std::min(n, omp_get_max_threads())))
     for (int k = 0; k < n; ++k) {
       const int i = todo[k];
-      out[i] = run_trial(settled, lambdas[i], crit, quiet);
+      try {
+        out[i] = run_trial(settled, lambdas[i], crit, quiet);
+      } catch (...) {
+        failed[i] = std::current_exception();
+        continue;
+      }
 #pragma omp critical(voussoir_journal)
-      journal.append(out[i]);
+      journal.append(trial_json(out[i]));
     }
+    for (const std::exception_ptr& e : failed)
+      if (e) std::rethrow_exception(e);
     for (size_t i = 0; i < out.size(); ++i) {
       const bool resumed = std::find(todo.begin(), todo.end(), int(i)) == todo.end();
       report(out[i], quiet, resumed);

@@ -31,7 +31,8 @@
 
 #include "core/step.hpp"
 #include "drivers/kinematics.hpp"
-#include "io/config.hpp"
+#include "drivers/trial.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 
@@ -43,6 +44,7 @@ struct TrialCriteria {
   double hold_time = 0.1;              // [s]
   double max_time = 3.0;               // [s] of simulated time after settling
   double settle_max_time = 5.0;        // [s]; a collapse under gravity ends it sooner
+  RunLimits limits;                    // guards and the user's limits (drivers/trial.hpp)
 };
 
 struct TrialResult {

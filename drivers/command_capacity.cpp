@@ -7,6 +7,7 @@
 
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/plot.hpp"
 #include "io/json.hpp"
 
 namespace voussoir {
@@ -29,7 +30,8 @@ nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
 
 int command_capacity(const Config& config, const CommonOptions& common,
                      const CapacityOptions& opts) {
-  const TrialCriteria& criteria = opts.criteria;
+  TrialCriteria criteria = opts.criteria;
+  criteria.limits = common.limits;
   CapacitySearch search;
   search.points = opts.points;
   search.quiet = common.quiet;
@@ -68,12 +70,8 @@ int command_capacity(const Config& config, const CommonOptions& common,
       char title[160];
       std::snprintf(title, sizeof title, "failure mode at lambda = %.4f (lambda* = %.4f)", res.hi,
                     res.lambda_star);
-      const std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
-                              "/scripts/draw '" + tmp + "' -o '" + opts.picture +
-                              "' --no-mesh --title '" + title + "'";
-      if (std::system(cmd.c_str()) != 0)
-        std::fprintf(stderr, "voussoir: warning: the picture %s could not be drawn\n",
-                     opts.picture.c_str());
+      draw_with_script("draw", {tmp, "-o", opts.picture, "--no-mesh", "--title", title},
+                       opts.picture);
       std::remove(tmp.c_str());
     }
   }

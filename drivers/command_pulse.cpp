@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drivers/commands.hpp"
+#include "drivers/plot.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
@@ -64,7 +65,8 @@ SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {
 
 int single_run(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
   const auto wall0 = Clock::now();
-  const PulseCriteria crit;
+  PulseCriteria crit;
+  crit.settle.limits = common.limits;
   const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
   if (signal.kind() == BaseSignal::Kind::None)
     throw DeckError(config.deck_path +
@@ -197,7 +199,8 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
                     "\": pulse --curve needs an analytic pulse (windowed_sine or sine_pulse)");
   if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
     throw DeckError("pulse --tolerance " + std::to_string(opts.tolerance) + " must lie in (0, 1)");
-  const PulseCriteria crit;
+  PulseCriteria crit;
+  crit.settle.limits = common.limits;
 
   double lambda_star = opts.lambda_star;
   double capacity_wall = 0.0;
@@ -267,11 +270,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
                 p.bracketed ? "" : "  (no collapse up to the cap)");
   std::printf("curve %s; %.1f s wall in all\n", csv_path.c_str(), wall);
   if (!opts.plot.empty()) {
-    const std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
-                            "/scripts/plot_curve '" + csv_path + "' -o '" + opts.plot + "'";
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
-                   opts.plot.c_str());
+    draw_with_script("plot_curve", {csv_path, "-o", opts.plot}, opts.plot);
   }
 
   if (!common.json_path.empty()) {

@@ -171,6 +171,11 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
   loop.sample_every = series_every;
   loop.quiet = common.quiet;
   loop.label = "run";
+  loop.limits = common.limits;
+  LoadProgram loads;
+  loads.gravity = config.load.gravity;
+  loads.lambda = config.load.lambda;
+  loop.loads = loads;
   if (checkpoints) {
     loop.checkpoint_every = opts.checkpoint_every;
     loop.checkpoint_at_end = true;  // so that a restart can extend a finished run

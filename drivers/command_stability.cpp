@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drivers/commands.hpp"
+#include "drivers/plot.hpp"
 #include "drivers/stability.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
@@ -52,11 +53,12 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
     throw DeckError("stability needs at least one --param KEY=V1,V2,... or KEY=start:stop:step");
   if (!(opts.ke_time > 0.0) || !(opts.max_time > 0.0))
     throw DeckError("--ke-time and --max-time must be positive seconds");
-  std::vector<StabilityAxis> axes;
-  for (const std::string& p : opts.params) axes.push_back(parse_stability_param(p));
-  const StabilityGrid grid = make_stability_grid(deck_path, sets, axes);
+  std::vector<GridAxis> axes;
+  for (const std::string& p : opts.params) axes.push_back(parse_grid_param(p));
+  const Grid grid = make_grid(deck_path, sets, axes);
   StabilityCriteria crit;
   crit.ke_time = opts.ke_time;
+  crit.trial.limits = common.limits;
   crit.trial.max_time = opts.max_time;
   if (!common.quiet)
     std::fprintf(stderr,
@@ -72,7 +74,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   std::ofstream csv(csv_path + ".tmp");
   if (!csv) throw OutputError("cannot write " + csv_path);
   csv.precision(10);
-  for (const StabilityAxis& a : axes) csv << a.key << ',';
+  for (const GridAxis& a : axes) csv << a.key << ',';
   csv << "thickness,radius,friction,stable,reason,kinetic_energy,normalised_ke,ke_time,"
          "ke_length,free_mass,max_displacement,max_rotation,decision_time,sim_time,steps,"
          "triangles,dt,wall_s,la_admissible,disagree,error\n";
@@ -159,9 +161,11 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
       "analysis, %d failed; written to %s (%.1f s wall)\n",
       cells.size(), n_stable, cells.size() - n_stable - n_error, n_disagree, n_error,
       csv_path.c_str(), wall);
+  for (const StabilityCell& r : cells)
+    if (!r.error.empty()) std::fprintf(stderr, "voussoir: run failed: %s\n", r.error.c_str());
   if (!common.json_path.empty()) {
     nlohmann::json jaxes = nlohmann::json::array();
-    for (const StabilityAxis& a : axes) {
+    for (const GridAxis& a : axes) {
       nlohmann::json vals = nlohmann::json::array();
       for (const std::string& v : a.values) vals.push_back(param_value(v));
       jaxes.push_back({{"key", a.key}, {"values", vals}});
@@ -183,13 +187,9 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
                common.json_path);
   }
   if (!opts.plot.empty()) {
-    std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
-                      "/scripts/plot_stability '" + csv_path + "' -o '" + opts.plot + "'";
-    if (keep_modes) cmd += " --modes '" + opts.mode_out + "'";
-    std::fflush(stdout);  // our summary before the script's table
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
-                   opts.plot.c_str());
+    std::vector<std::string> args = {csv_path, "-o", opts.plot};
+    if (keep_modes) args.insert(args.end(), {"--modes", opts.mode_out});
+    draw_with_script("plot_stability", args, opts.plot);
   }
   return n_error > 0 ? 1 : 0;
 }

@@ -10,90 +10,63 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/fnv.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/plot.hpp"
+#include "drivers/grid.hpp"
+#include "drivers/journal.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
 
 namespace voussoir {
-namespace {
-
-struct Axis {
-  std::string key;
-  std::vector<std::string> values;
-};
-
-Axis parse_param(const std::string& text) {
-  const auto eq = text.find('=');
-  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
-    throw DeckError("--param '" + text + "': expected KEY=V1,V2,...");
-  Axis a;
-  a.key = text.substr(0, eq);
-  std::stringstream ss(text.substr(eq + 1));
-  std::string v;
-  while (std::getline(ss, v, ',')) {
-    if (v.empty()) throw DeckError("--param '" + text + "': empty value in the list");
-    a.values.push_back(v);
-  }
-  return a;
-}
-
-}  // namespace
 
 int command_sweep(const std::string& deck_path, const std::vector<std::string>& sets,
                   const CommonOptions& common, const SweepOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
   if (opts.params.empty()) throw DeckError("sweep needs at least one --param KEY=V1,V2,...");
-  std::vector<Axis> axes;
-  for (const std::string& p : opts.params) axes.push_back(parse_param(p));
-
-  // The grid, row-major with the last axis fastest; every cell's deck validated up front so
-  // a bad value stops the sweep before any work.
-  size_t cells = 1;
-  for (const Axis& a : axes) cells *= a.values.size();
-  std::vector<std::vector<std::string>> cell_values(cells);
-  std::vector<Config> configs;
-  for (size_t c = 0; c < cells; ++c) {
-    size_t rest = c;
-    std::vector<std::string> cell_sets = sets;
-    std::vector<std::string> vals(axes.size());
-    for (size_t k = axes.size(); k-- > 0;) {
-      vals[k] = axes[k].values[rest % axes[k].values.size()];
-      rest /= axes[k].values.size();
-      cell_sets.push_back(axes[k].key + "=" + vals[k]);
-    }
-    cell_values[c] = vals;
-    configs.push_back(load_deck(deck_path, cell_sets));
-  }
+  std::vector<GridAxis> axes;
+  for (const std::string& p : opts.params) axes.push_back(parse_grid_param(p));
+  // Every cell's deck validated up front, so a bad value stops the sweep before any work.
+  const Grid grid = make_grid(deck_path, sets, axes);
+  const size_t cells = grid.configs.size();
+  const std::vector<std::vector<std::string>>& cell_values = grid.values;
+  const std::vector<Config>& configs = grid.configs;
 
   std::vector<CapacityResult> results(cells);
   std::vector<std::string> errors(cells);
-  const TrialCriteria& criteria = opts.criteria;
-  // Resume: the journal holds one JSON line per finished cell ({"cell": i, "values": [...],
-  // result}); cells found there with the same values are not run again.
-  std::vector<bool> finished(cells, false);
-  if (!opts.resume.empty()) {
-    std::ifstream in(opts.resume);
-    for (std::string line; std::getline(in, line);) {
-      const auto j = nlohmann::json::parse(line, nullptr, false);
-      if (j.is_discarded() || !j.contains("cell")) continue;  // cut by a kill: run it again
-      const size_t c = j["cell"];
-      if (c >= cells || j["values"] != nlohmann::json(cell_values[c]))
-        throw DeckError("--resume " + opts.resume + ": the journal belongs to another sweep");
-      CapacityResult& r = results[c];
-      r.lambda_star = j["lambda_star"];
-      r.lo = j["lo"];
-      r.hi = j["hi"];
-      r.bracketed = j["bracketed"];
-      r.trials.resize(j["trials"].get<size_t>());
-      r.wall_s = j["wall_s"];
-      errors[c] = j["error"];
-      finished[c] = true;
-    }
+  TrialCriteria criteria = opts.criteria;
+  criteria.limits = common.limits;
+  // Resume (drivers/journal.hpp): one record per finished cell ({"cell": i, "values": [...],
+  // result}) under the fingerprint of the deck, overrides, axes and criteria; cells found
+  // there are not run again.
+  Fnv print;
+  print.text(deck_path);
+  for (const std::string& set : sets) print.text(set);
+  for (const GridAxis& a : axes) {
+    print.text(a.key);
+    for (const std::string& v : a.values) print.text(v);
   }
-  std::ofstream journal;
-  if (!opts.resume.empty()) journal.open(opts.resume, std::ios::app);
+  print.value(opts.points);
+  print.value(criteria.settle_max_time);
+  Journal journal(opts.resume, print.hex());
+  std::vector<bool> finished(cells, false);
+  for (const nlohmann::json& j : journal.records()) {
+    if (!j.contains("cell")) continue;
+    const size_t c = j["cell"];
+    if (c >= cells || j["values"] != nlohmann::json(cell_values[c]))
+      throw DeckError("--resume " + opts.resume + ": the journal belongs to another sweep");
+    CapacityResult& r = results[c];
+    r.lambda_star = j["lambda_star"];
+    r.lo = j["lo"];
+    r.hi = j["hi"];
+    r.bracketed = j["bracketed"];
+    r.trials.resize(j["trials"].get<size_t>());
+    r.wall_s = j["wall_s"];
+    errors[c] = j["error"];
+    finished[c] = true;
+  }
   int done = 0;
 #pragma omp parallel for schedule(dynamic, 1)
   for (long c = 0; c < static_cast<long>(cells); ++c) {
@@ -105,21 +78,16 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
     }
 #pragma omp critical
     {
-      if (journal.is_open()) {
-        const CapacityResult& r = results[c];
-        journal << nlohmann::json{{"cell", c},
-                                  {"values", cell_values[c]},
-                                  {"lambda_star", r.lambda_star},
-                                  {"lo", r.lo},
-                                  {"hi", r.hi},
-                                  {"bracketed", r.bracketed},
-                                  {"trials", r.trials.size()},
-                                  {"wall_s", r.wall_s},
-                                  {"error", errors[c]}}
-                       .dump()
-                << '\n'
-                << std::flush;
-      }
+      const CapacityResult& r = results[c];
+      journal.append({{"cell", c},
+                      {"values", cell_values[c]},
+                      {"lambda_star", r.lambda_star},
+                      {"lo", r.lo},
+                      {"hi", r.hi},
+                      {"bracketed", r.bracketed},
+                      {"trials", r.trials.size()},
+                      {"wall_s", r.wall_s},
+                      {"error", errors[c]}});
       ++done;
       if (!common.quiet) {
         std::fprintf(stderr, "[%d/%zu]", done, cells);
@@ -138,7 +106,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   std::ofstream csv(csv_path + ".tmp");
   csv.precision(17);
   if (!csv) throw OutputError("cannot write " + csv_path);
-  for (const Axis& a : axes) csv << a.key << ',';
+  for (const GridAxis& a : axes) csv << a.key << ',';
   // The CSV holds results only (no wall times), so a resumed sweep writes the same file as an
   // uninterrupted one; wall times are in the JSON and on stderr.
   csv << "lambda_star,lo,hi,bracketed,trials,error\n";
@@ -168,15 +136,15 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   if (!common.json_path.empty())
     write_json({{"cells", jcells}, {"csv", csv_path}, {"wall_s", wall}}, common.json_path);
   if (!opts.plot.empty()) {
-    const std::string cmd = std::string("/usr/bin/python3 ") + VOUSSOIR_SOURCE_DIR +
-                            "/scripts/plot_sweep '" + csv_path + "' -o '" + opts.plot + "'";
-    if (std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "voussoir: warning: the plot %s could not be drawn\n",
-                   opts.plot.c_str());
+    draw_with_script("plot_sweep", {csv_path, "-o", opts.plot}, opts.plot);
   }
+  int failed = 0;
   for (const std::string& e : errors)
-    if (!e.empty()) return 1;
-  return 0;
+    if (!e.empty()) {
+      std::fprintf(stderr, "voussoir: run failed: %s\n", e.c_str());
+      ++failed;
+    }
+  return failed > 0 ? 1 : 0;
 }
 
 }  // namespace voussoir

@@ -11,7 +11,7 @@
 #include "core/model.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/kinematics.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 
@@ -19,6 +19,7 @@ struct CommonOptions {
   std::string json_path;     // --json FILE ("" = none, "-" = stdout)
   int threads = 0;           // --threads N (0 = OpenMP default)
   bool quiet = false;        // no progress on stderr
+  RunLimits limits;          // the engine's limits (add_limit_options, drivers/trial.hpp)
 };
 
 struct CheckOptions {

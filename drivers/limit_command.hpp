@@ -4,7 +4,7 @@
 #include <string>
 
 #include "drivers/commands.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 

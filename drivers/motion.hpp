@@ -64,10 +64,12 @@ inline double reference_length(const Model& model) {
 // At rest: the largest free-node speed has stayed below v_rest for the hold window, and the
 // kinetic energy is not growing over it (its peak over the second half of the window is no
 // larger than over the first half). The second condition tells a decaying oscillation from a
-// mechanism that has just started to move and is still slow.
+// mechanism that has just started to move and is still slow. With require_decay false the
+// speed alone decides (the pulses: a structure rocking to rest after the signal).
 class RestDetector {
  public:
-  RestDetector(double v_rest, double hold) : v_rest_(v_rest), hold_(hold) {}
+  RestDetector(double v_rest, double hold, bool require_decay = true)
+      : v_rest_(v_rest), hold_(hold), require_decay_(require_decay) {}
   bool update(double t, double v_max, double kinetic) {
     if (v_max >= v_rest_) {
       window_.clear();
@@ -76,6 +78,7 @@ class RestDetector {
     window_.push_back({t, kinetic});
     const double t0 = window_.front().t;
     if (t - t0 < hold_) return false;
+    if (!require_decay_) return true;
     const double mid = t0 + 0.5 * (t - t0);
     double first = 0.0, second = 0.0;
     for (const Sample& s : window_) {
@@ -93,6 +96,7 @@ class RestDetector {
     double t, kinetic;
   };
   double v_rest_, hold_;
+  bool require_decay_;
   std::vector<Sample> window_;
 };
 

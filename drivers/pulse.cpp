@@ -13,6 +13,7 @@
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/trial.hpp"
 
 namespace voussoir {
 namespace {
@@ -106,24 +107,32 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   const double dt = sim.ctx.dt;
   const long long step0 = sim.step;
 
-  // Optional lambda ramp before the signal (as in a capacity trial).
+  char label[96];
+  std::snprintf(label, sizeof label, "the pulse run of peak base acceleration %.6g g",
+                signal.peak_acceleration() / std::max(g, 1e-12));
+  // Loads: gravity, lambda g ramped on before the signal as in a capacity trial, then the
+  // signal from its time 0 (the end of the ramp).
+  LoadProgram loads;
+  loads.gravity = g;
+  loads.lambda = lambda;
+  loads.lambda_ramp = crit.settle.ramp_time;
+  loads.start = sim.ctx.time;
   if (lambda != 0.0) {
-    const double t_ramp0 = sim.ctx.time;
-    while (sim.ctx.time - t_ramp0 < crit.settle.ramp_time) {
-      set_static_load(sim, g,
-                      lambda * std::min(1.0, (sim.ctx.time - t_ramp0) / crit.settle.ramp_time));
-      advance(sim);
-    }
-    check_finite(sim);
+    RunSpec ramp;
+    ramp.label = std::string(label) + " (lambda ramp)";
+    ramp.loads = loads;
+    ramp.limits = crit.settle.limits;
+    ramp.sample_every = crit.sample_time;
+    ramp.sample_origin = step0;
+    ramp.end_time = crit.settle.ramp_time;
+    run_engine(sim, ramp);
   }
 
   const double t0 = sim.ctx.time;
-  const long long every = std::max(1LL, std::llround(crit.sample_time / dt));
   const long long rec_every = std::max(1LL, std::llround(record_every / dt));
   const double duration = signal.duration();
   const double v_rest = crit.rest_speed * std::sqrt(std::max(g, 1e-12) * settled.l_ref);
   const double d_fall = crit.fall_displacement * settled.l_ref;
-  const std::vector<BlockMotion> base = block_motions(sim.model);
   std::vector<double> cx0(points.size()), cy0(points.size());
   for (size_t p = 0; p < points.size(); ++p) {
     cx0[p] = sim.model.nodes.x[points[p].node];
@@ -163,7 +172,6 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   };
 
   record(sim);
-  std::vector<double> measure;  // motion measure after the signal (timeout decision)
   // Energy balance. imbalance = W - K - U - C - D [J]; its value at the signal start is what
   // the settling left (the ledger runs from the unloaded state); the pulse's own error is the
   // change from there.
@@ -173,60 +181,41 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   const double imbalance0 = imbalance_of(sim.ledger);
   double max_imbalance = std::abs(imbalance0);  // largest |imbalance| at the samples
   double max_pulse_imbalance = 0.0;             // largest |imbalance - imbalance0|
-  double rest_since = -1.0;
-  bool decided = false;
-  const double body_x0 = lambda * g;
-  while (!decided) {
-    const double t = sim.ctx.time - t0;
-    sim.ctx.body_ax = body_x0 - signal.acceleration(t);
-    sim.ctx.body_ay = -g;
-    advance(sim);
-    r.max_kinetic_energy = std::max(r.max_kinetic_energy, sim.ledger.kinetic);
-    const long long k = sim.step - step0;
-    if (k % rec_every == 0) record(sim);
-    if (k % every != 0) continue;
-    check_finite(sim);
-    const double ts = sim.ctx.time - t0;
-    const EnergyLedger& l = sim.ledger;
+
+  // The signal: fall at any time; after the signal, rest (speed alone) or the trend at
+  // duration + free_time. Samples and records on the grids counted from the settled state.
+  RunSpec spec;
+  spec.label = label;
+  spec.loads = loads;
+  spec.loads->signal = &signal;
+  spec.loads->signal_start = t0;
+  spec.limits = crit.settle.limits;
+  spec.sample_every = crit.sample_time;
+  spec.sample_origin = step0;
+  spec.track_motion = true;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_fall, crit.fall_rotation, "fall", "fall"));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, duration, false));
+  spec.rules.push_back(std::make_unique<TrendRule>(d_fall, crit.fall_rotation, duration, duration,
+                                                   duration + crit.free_time));
+  spec.on_step = [&](const Simulation& s, const StepInfo&) {
+    r.max_kinetic_energy = std::max(r.max_kinetic_energy, s.ledger.kinetic);
+    if ((s.step - step0) % rec_every == 0) record(s);
+  };
+  spec.on_sample = [&](const Simulation& s, const Probe&) {
+    const EnergyLedger& l = s.ledger;
     max_imbalance = std::max(max_imbalance, std::abs(imbalance_of(l)));
     max_pulse_imbalance = std::max(max_pulse_imbalance, std::abs(imbalance_of(l) - imbalance0));
-    update_controls(sim);
-    const std::vector<BlockMotion> now = block_motions(sim.model);
-    double dmax = 0.0, rmax = 0.0;
-    for (size_t b = 0; b < now.size(); ++b) {
-      if (sim.model.blocks[b].fixed) continue;
-      dmax = std::max(dmax, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
-      rmax = std::max(rmax, std::abs(now[b].rotation - base[b].rotation));
-    }
-    r.max_displacement = std::max(r.max_displacement, dmax);
-    r.max_rotation = std::max(r.max_rotation, rmax);
-    r.residual_displacement = dmax;
-    r.residual_rotation = rmax;
-    r.decided_at = ts;
-    if (dmax > d_fall || rmax > crit.fall_rotation) {
-      r.collapsed = true;
-      r.reason = "fall";
-      break;
-    }
-    if (ts < duration) continue;
-    measure.push_back(std::max(dmax / d_fall, rmax / crit.fall_rotation));
-    if (max_free_speed(sim.model.nodes) < v_rest) {
-      if (rest_since < 0.0) rest_since = ts;
-      if (ts - rest_since >= crit.hold_time) {
-        r.reason = "rest";
-        decided = true;
-      }
-    } else {
-      rest_since = -1.0;
-    }
-    if (!decided && ts >= duration + crit.free_time) {
-      const size_t cut = measure.size() * 2 / 3;
-      const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
-      r.collapsed = measure.back() > 1.1 * earlier;
-      r.reason = "timeout";
-      decided = true;
-    }
-  }
+    update_controls(s);
+    return true;
+  };
+  const Outcome o = run_engine(sim, spec);
+  r.collapsed = o.collapsed;
+  r.reason = o.reason;
+  r.decided_at = o.sample_time;
+  r.max_displacement = o.peak_motion.displacement;
+  r.max_rotation = o.peak_motion.rotation;
+  r.residual_displacement = o.motion.displacement;
+  r.residual_rotation = o.motion.rotation;
   record(sim);
   r.steps = sim.step - step0;
   // Largest imbalance over the run relative to the run's peak energy (SPEC: "below 1% of the

@@ -1,7 +1,7 @@
 #pragma once
-// The time loop shared by `run`, `capacity`, `pulse` and the tests: advance the simulation,
-// guard against non-finite state and energy drift, sample the series, write checkpoints,
-// report progress.
+// `voussoir run`'s configuration of the engine (drivers/trial.hpp), also used by the tests:
+// advance to an end time, sample the series, write checkpoints, report progress; the engine's
+// guards against non-finite state and energy drift stop a broken run.
 //
 // Guards (SPEC.md section 2: "no NaN silently written"; docs/robustness.md). At every sample:
 //   - non-finite: any node position, velocity or force, or any term of the energy ledger,
@@ -24,33 +24,24 @@
 //     state stays finite -- the viscous term oscillates and books dissipation without bound, and
 //     the hyperelastic law keeps even an undamped blow-up finite), work booked twice or lost, a
 //     contact energy out of step with its forces.
-// Both throw RunError (exit status 1) naming the step, the time and where: the node, its
-// block and a triangle that holds it.
+// Both throw RunError (exit status 1) naming the run, the step, the time, the quantity and
+// where: the node, its block and a triangle that holds it.
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "core/step.hpp"
+#include "drivers/trial.hpp"
 
 namespace voussoir {
 
-// Largest balance error of the energy ledger a run may reach (dimensionless, relative to the
-// peak energy; see above).
-inline constexpr double kEnergyDriftLimit = 0.05;
-// Steps after which the energy guard is armed (see above).
-inline constexpr long long kEnergyDriftArmSteps = 1000;
+// (kEnergyDriftLimit, kEnergyDriftArmSteps, check_finite and check_energy_balance: the
+// engine's guards, drivers/trial.hpp.)
 
 // Largest displacement magnitude of any free node from its reference position [m].
 double max_free_displacement(const Model& model);
-
-// Throws RunError naming the step, time, block and triangle when any node position, velocity
-// or force, or any energy of the ledger, is not finite.
-void check_finite(const Simulation& sim);
-
-// Throws RunError naming the step, time and the fastest node (its block and a triangle) when
-// sim.ledger.balance_error() exceeds `limit`.
-void check_energy_balance(const Simulation& sim, double limit = kEnergyDriftLimit);
 
 struct LoopStats {
   long long steps = 0;
@@ -65,6 +56,8 @@ struct LoopOptions {
   std::string label = "run";               // progress line prefix
   double drift_limit = kEnergyDriftLimit;  // <= 0: energy guard off
   long long drift_arm_steps = kEnergyDriftArmSteps;  // guard checked from this step on
+  RunLimits limits;                        // the user's limits (drift fields above win)
+  std::optional<LoadProgram> loads;        // none: the loads of ctx are left as they are
   // Checkpoints: `checkpoint(sim, stats)` after every `checkpoint_every` seconds of simulated
   // time (rounded to whole steps, at least one; 0 = never), after that step's sample if it has
   // one; and, with checkpoint_at_end, after the last step too -- but before its sample when

@@ -7,14 +7,11 @@
 #include <vector>
 
 #include "core/step.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 
-// A failure during a run (non-finite state, energy blow-up): exit status 1.
-struct RunError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+// (RunError: core/schema.hpp.)
 
 struct SetupInfo {
   double dt = 0.0;           // time step in use [s]

@@ -17,6 +17,7 @@
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/trial.hpp"
 #include "io/deck.hpp"
 #include "limit/limit_analysis.hpp"
 #include "mesh/scene.hpp"
@@ -26,101 +27,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Whole text parsed as a finite number.
-bool parse_number(const std::string& s, double& v) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  v = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size() && std::isfinite(v);
-}
-
-// Digits after the decimal point of a plain decimal ("0.05" -> 2, "3" -> 0); -1 when the
-// number has an exponent (printed with %.12g then).
-int decimals_of(const std::string& s) {
-  if (s.find_first_of("eE") != std::string::npos) return -1;
-  const auto dot = s.find('.');
-  return dot == std::string::npos ? 0 : static_cast<int>(s.size() - dot - 1);
-}
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
-std::string format_number(double v, int decimals) {
-  char buf[64];
-  if (decimals >= 0)
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  else
-    std::snprintf(buf, sizeof buf, "%.12g", v);
-  std::string s = buf;
-  if (s == "-0" || s.rfind("-0.", 0) == 0) {  // no negative zero from rounding
-    double z = 0.0;
-    if (parse_number(s, z) && z == 0.0) s = s.substr(1);
-  }
-  return s;
-}
-
 bool is_arch(const std::string& kind) {
   return kind == "circular_arch" || kind == "basket_arch" || kind == "buttressed_arch";
 }
 
 }  // namespace
-
-std::vector<std::string> expand_range(const std::string& spec) {
-  std::vector<std::string> parts;
-  std::stringstream ss(spec);
-  std::string p;
-  while (std::getline(ss, p, ':')) parts.push_back(trim(p));
-  double start = 0.0, stop = 0.0, step = 0.0;
-  if (parts.size() != 3 || !parse_number(parts[0], start) || !parse_number(parts[1], stop) ||
-      !parse_number(parts[2], step))
-    throw DeckError("range '" + spec + "': expected start:stop:step (three numbers)");
-  if (!(step > 0.0)) throw DeckError("range '" + spec + "': the step must be positive");
-  if (stop < start) throw DeckError("range '" + spec + "': stop is below start");
-  // Count by integer steps with a tolerance of 1e-9 step, so a stop on the grid is included
-  // whatever the rounding of (stop - start) / step.
-  const double span = (stop - start) / step;
-  if (span > 1e6) throw DeckError("range '" + spec + "': more than a million values");
-  const long n = static_cast<long>(std::floor(span + 1e-9)) + 1;
-  int decimals = -1;
-  const int d0 = decimals_of(parts[0]), d2 = decimals_of(parts[2]);
-  if (d0 >= 0 && d2 >= 0) decimals = std::max(d0, d2);
-  std::vector<std::string> out;
-  out.reserve(n);
-  for (long i = 0; i < n; ++i) out.push_back(format_number(start + i * step, decimals));
-  return out;
-}
-
-StabilityAxis parse_stability_param(const std::string& text) {
-  const auto eq = text.find('=');
-  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
-    throw DeckError("--param '" + text + "': expected KEY=V1,V2,... or KEY=start:stop:step");
-  StabilityAxis a;
-  a.key = trim(text.substr(0, eq));
-  std::stringstream ss(text.substr(eq + 1));
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    item = trim(item);
-    if (item.empty()) throw DeckError("--param '" + text + "': empty value in the list");
-    if (item.find(':') != std::string::npos) {
-      for (std::string& v : expand_range(item)) a.values.push_back(std::move(v));
-    } else {
-      a.values.push_back(item);
-    }
-  }
-  if (a.key == kThicknessRatioKey)
-    for (const std::string& v : a.values) {
-      double r = 0.0;
-      if (!parse_number(v, r) || !(r > 0.0))
-        throw DeckError("--param '" + text +
-                        "': model.thickness_ratio must be positive numbers, "
-                        "got '" +
-                        v + "'");
-    }
-  return a;
-}
 
 double stability_ke_length(const Config& config, const Model& model) {
   if (is_arch(config.model.kind)) return config.model.radius;
@@ -135,7 +46,7 @@ double stability_ke_length(const Config& config, const Model& model) {
 }
 
 StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& crit,
-                                 bool keep_mode) {
+                                 bool keep_mode, const std::string& cell_label) {
   const auto t0 = Clock::now();
   Config config = deck;
   config.load.lambda = 0.0;  // gravity only
@@ -155,60 +66,38 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   c.ke_length = stability_ke_length(config, sim.model);
   const double g = config.load.gravity;
   const double ke_scale = c.free_mass * g * c.ke_length;
-  const long long every = std::max(1LL, std::llround(kSampleTime / sim.ctx.dt));
   const double v_rest = tc.rest_speed * std::sqrt(std::max(g, 1e-12) * c.l_ref);
   const double d_collapse = tc.collapse_displacement * c.l_ref;
-  const std::vector<BlockMotion> base = block_motions(sim.model);  // rest, unloaded
 
-  std::vector<double> measure;  // motion measure per sample (1 = collapse threshold)
-  RestDetector rest(v_rest, tc.hold_time);
-  bool decided = false, ke_read = false;
-  while (!(decided && ke_read)) {
-    const double t = sim.ctx.time;
-    set_static_load(sim, g * std::min(1.0, t / tc.ramp_time), 0.0);
-    advance(sim);
-    if (sim.step % every != 0) continue;
-    check_finite(sim);
-    const double now = sim.ctx.time;
-    const std::vector<BlockMotion> m = block_motions(sim.model);
-    double dmax = 0.0, rmax = 0.0;
-    for (size_t b = 0; b < m.size(); ++b) {
-      if (sim.model.blocks[b].fixed) continue;
-      dmax = std::max(dmax, std::hypot(m[b].ux - base[b].ux, m[b].uy - base[b].uy));
-      rmax = std::max(rmax, std::abs(m[b].rotation - base[b].rotation));
-    }
-    c.max_displacement = dmax;
-    c.max_rotation = rmax;
-    if (!ke_read && now >= crit.ke_time) {
-      c.kinetic_energy = sim.ledger.kinetic;
-      c.ke_read_time = now;
+  // Gravity ramped on from rest; motions measured from the unloaded geometry. A decided cell
+  // runs on to ke_time, when its kinetic energy is read.
+  RunSpec spec;
+  spec.label = "the stability cell " + cell_label;
+  spec.loads = LoadProgram{};
+  spec.loads->gravity = g;
+  spec.loads->gravity_ramp = tc.ramp_time;
+  spec.limits = tc.limits;
+  spec.track_motion = true;
+  spec.min_time = crit.ke_time;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, tc.collapse_rotation));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, tc.hold_time, tc.ramp_time));
+  spec.rules.push_back(
+      std::make_unique<TrendRule>(d_collapse, tc.collapse_rotation, 0.0, tc.ramp_time, tc.max_time));
+  bool ke_read = false;
+  spec.on_sample = [&](const Simulation& s, const Probe& p) {
+    if (!ke_read && p.time >= crit.ke_time) {
+      c.kinetic_energy = s.ledger.kinetic;
+      c.ke_read_time = p.time;
       ke_read = true;
     }
-    if (decided) continue;
-    measure.push_back(std::max(dmax / d_collapse, rmax / tc.collapse_rotation));
-    if (dmax > d_collapse || rmax > tc.collapse_rotation) {
-      c.stable = false;
-      c.reason = dmax > d_collapse ? "displacement" : "rotation";
-      decided = true;
-    } else if (now >= tc.ramp_time) {
-      if (rest.update(now, max_free_speed(sim.model.nodes), sim.ledger.kinetic)) {
-        c.stable = true;
-        c.reason = "rest";
-        decided = true;
-      }
-      if (!decided && now >= tc.max_time) {
-        // Critical slowing down near the threshold: decide by the trend, as capacity does
-        // (drivers/capacity.cpp): collapsed when the motion measure now exceeds by 10% its
-        // largest value over the first two thirds of the run.
-        const size_t cut = measure.size() * 2 / 3;
-        const double earlier = *std::max_element(measure.begin(), measure.begin() + cut + 1);
-        c.stable = !(measure.back() > 1.1 * earlier);
-        c.reason = "timeout";
-        decided = true;
-      }
-    }
-    if (decided) c.decision_time = now;
-  }
+    return true;
+  };
+  const Outcome o = run_engine(sim, spec);
+  c.stable = !o.collapsed;
+  c.reason = o.reason;
+  c.decision_time = o.decided_at;
+  c.max_displacement = o.motion.displacement;
+  c.max_rotation = o.motion.rotation;
   c.normalised_ke = ke_scale > 0.0 ? c.kinetic_energy / ke_scale : 0.0;
   c.sim_time = sim.ctx.time;
   c.steps = sim.step;
@@ -244,47 +133,7 @@ void check_limit_admissibility(const Config& config, StabilityCell& cell) {
   }
 }
 
-StabilityGrid make_stability_grid(const std::string& deck_path,
-                                  const std::vector<std::string>& sets,
-                                  const std::vector<StabilityAxis>& axes) {
-  StabilityGrid grid;
-  grid.axes = axes;
-  size_t cells = 1;
-  for (const StabilityAxis& a : axes) {
-    if (a.values.empty()) throw DeckError("--param " + a.key + ": no values");
-    cells *= a.values.size();
-  }
-  for (size_t c = 0; c < cells; ++c) {
-    size_t rest = c;
-    std::vector<std::string> vals(axes.size());
-    for (size_t k = axes.size(); k-- > 0;) {
-      vals[k] = axes[k].values[rest % axes[k].values.size()];
-      rest /= axes[k].values.size();
-    }
-    std::vector<std::string> cell_sets = sets;
-    const StabilityAxis* ratio = nullptr;
-    std::string ratio_value;
-    for (size_t k = 0; k < axes.size(); ++k) {
-      if (axes[k].key == kThicknessRatioKey) {
-        ratio = &axes[k];
-        ratio_value = vals[k];
-      } else {
-        cell_sets.push_back(axes[k].key + "=" + vals[k]);
-      }
-    }
-    if (ratio) {
-      // thickness = ratio x radius of this cell's deck (after every other override).
-      const Config partial = load_deck(deck_path, cell_sets);
-      const double t = std::strtod(ratio_value.c_str(), nullptr) * partial.model.radius;
-      cell_sets.push_back("model.thickness=" + format_number(t, -1));
-    }
-    grid.configs.push_back(load_deck(deck_path, cell_sets));
-    grid.values.push_back(std::move(vals));
-  }
-  return grid;
-}
-
-std::vector<StabilityCell> run_stability_map(const StabilityGrid& grid,
+std::vector<StabilityCell> run_stability_map(const Grid& grid,
                                              const StabilityCriteria& crit, int threads,
                                              bool keep_modes, bool quiet) {
   const long cells = static_cast<long>(grid.configs.size());
@@ -301,7 +150,10 @@ std::vector<StabilityCell> run_stability_map(const StabilityGrid& grid,
   for (long c = 0; c < cells; ++c) {
     StabilityCell& r = out[c];
     try {
-      r = run_stability_cell(grid.configs[c], crit, keep_modes);
+      std::string label;
+      for (size_t k = 0; k < grid.axes.size(); ++k)
+        label += (k ? " " : "") + grid.axes[k].key + "=" + grid.values[c][k];
+      r = run_stability_cell(grid.configs[c], crit, keep_modes, label);
       if (r.stable) {  // outlines are only wanted for collapse modes
         r.outlines.clear();
         r.outlines0.clear();

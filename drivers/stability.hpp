@@ -39,30 +39,11 @@
 #include "core/model.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/grid.hpp"
 #include "drivers/kinematics.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
-
-// One axis of the map, from `--param KEY=V1,V2,...` or `--param KEY=start:stop:step`.
-// The key `model.thickness_ratio` is a convenience: the cell's model.thickness becomes
-// ratio x model.radius (the radius of the cell's deck).
-struct StabilityAxis {
-  std::string key;
-  std::vector<std::string> values;  // as written to the deck override
-};
-
-inline constexpr const char* kThicknessRatioKey = "model.thickness_ratio";
-
-// Expands "start:stop:step" into decimal strings start, start + step, ... up to stop included
-// when stop lies on the grid (within 1e-9 of a step). Each value is computed as
-// start + i x step and printed with the number of decimals of the inputs, so 0.2:0.8:0.05
-// gives exactly "0.20", "0.25", ..., "0.80" (13 values, no floating drift). Throws DeckError
-// for a non-positive step, stop < start or text that is not three numbers.
-std::vector<std::string> expand_range(const std::string& spec);
-
-// Parses one --param; throws DeckError naming the text when malformed.
-StabilityAxis parse_stability_param(const std::string& text);
 
 struct StabilityCriteria {
   TrialCriteria trial;   // thresholds shared with capacity (ramp, collapse, rest, max_time)
@@ -70,7 +51,7 @@ struct StabilityCriteria {
 };
 
 struct StabilityCell {
-  std::vector<std::string> values;  // per axis, as in StabilityAxis::values
+  std::vector<std::string> values;  // per axis, as in GridAxis::values
   double thickness = 0.0;           // model.thickness of the cell [m]
   double radius = 0.0;              // model.radius of the cell [m]
   double friction = 0.0;            // contact.friction of the cell
@@ -105,31 +86,20 @@ struct StabilityCell {
 double stability_ke_length(const Config& config, const Model& model);
 
 // Runs one cell (the deck as given, lambda and base motion ignored); `keep_mode` keeps the
-// block outlines at the end. Throws RunError on a non-finite state.
+// block outlines at the end. Throws RunError from the engine's guards (non-finite state,
+// energy balance), naming the cell by `cell_label` (its --param values).
 StabilityCell run_stability_cell(const Config& config, const StabilityCriteria& criteria,
-                                 bool keep_mode);
+                                 bool keep_mode, const std::string& cell_label = "");
 
 // The limit-analysis cross-check of one cell (fills la_admissible and la_status). GLPK is not
 // assumed thread-safe: call it outside parallel regions.
 void check_limit_admissibility(const Config& config, StabilityCell& cell);
 
-struct StabilityGrid {
-  std::vector<StabilityAxis> axes;
-  std::vector<Config> configs;                   // row-major, last axis fastest
-  std::vector<std::vector<std::string>> values;  // per cell, per axis
-};
-
-// Builds every cell's deck (validated up front, so a bad value stops the map before any
-// work) from the deck file, the --set overrides and the axes.
-StabilityGrid make_stability_grid(const std::string& deck_path,
-                                  const std::vector<std::string>& sets,
-                                  const std::vector<StabilityAxis>& axes);
-
 // Runs every cell of the grid, in parallel over cells on `threads` threads (0 = OpenMP
 // default), then the limit-analysis cross-checks. `keep_modes` keeps the outlines of
 // collapsed cells. Progress lines on stderr unless quiet. A failing cell is reported in its
 // `error`, the others still run.
-std::vector<StabilityCell> run_stability_map(const StabilityGrid& grid,
+std::vector<StabilityCell> run_stability_map(const Grid& grid,
                                              const StabilityCriteria& criteria, int threads,
                                              bool keep_modes, bool quiet);
 

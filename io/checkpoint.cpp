@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "core/fnv.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
 
@@ -32,42 +33,10 @@ constexpr std::uint32_t kByteOrderTag = 0x01020304u;
 // without that interface, frictionless runs only; such files are refused.)
 constexpr std::uint8_t kContactBytes = 1;
 
-// FNV-1a, 64 bit.
-struct Fnv {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  void bytes(const void* p, std::size_t n) {
-    const auto* c = static_cast<const unsigned char*>(p);
-    for (std::size_t k = 0; k < n; ++k) {
-      h ^= c[k];
-      h *= 0x100000001b3ull;
-    }
-  }
-  template <class T>
-  void value(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    bytes(&v, sizeof v);
-  }
-  template <class T>
-  void array(const std::vector<T>& v) {
-    value<std::uint64_t>(v.size());
-    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
-  }
-};
-
 // Serialisation into a byte string.
-struct Out {
+struct Out : ByteWriter<Out> {
   std::string buf;
   void bytes(const void* p, std::size_t n) { buf.append(static_cast<const char*>(p), n); }
-  template <class T>
-  void value(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    bytes(&v, sizeof v);
-  }
-  template <class T>
-  void array(const std::vector<T>& v) {
-    value<std::uint64_t>(v.size());
-    if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
-  }
 };
 
 // Bounds-checked reading from the file contents; every failure names the file.

@@ -7,13 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 
-struct DeckError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+// (DeckError: core/schema.hpp.)
 
 // Reads the deck file, applies the `--set KEY=VALUE` overrides (dotted paths, same
 // validation as the file), validates every key and returns the result.

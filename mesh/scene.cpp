@@ -12,7 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "io/deck.hpp"
+#include "core/schema.hpp"
 #include "mesh/scene_spec.hpp"
 
 namespace voussoir {

@@ -4,7 +4,7 @@
 // DeckError naming the key and value.
 
 #include "core/model.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 
 namespace voussoir {
 

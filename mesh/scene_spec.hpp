@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "core/model.hpp"
-#include "io/config.hpp"
+#include "core/schema.hpp"
 #include "mesh/geometry.hpp"
 #include "mesh/triangulate.hpp"
 

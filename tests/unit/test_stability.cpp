@@ -71,13 +71,6 @@ bool all_finite(const Simulation& sim) {
   return true;
 }
 
-double reference_length(const Model& m) {
-  double a = std::numeric_limits<double>::infinity();
-  for (const Block& b : m.blocks)
-    if (!b.fixed) a = std::min(a, b.area);
-  return std::sqrt(a);
-}
-
 struct Figures {
   double dt = 0.0, dt_stable = 0.0;
   long long steps = 0;

@@ -46,29 +46,29 @@ TEST(StabilityRange, ExpandsWithoutFloatingDrift) {
   for (size_t i = 0; i < v.size(); ++i)
     EXPECT_NEAR(std::strtod(v[i].c_str(), nullptr), 0.2 + 0.05 * i, 1e-15) << i;
 
-  const StabilityAxis t = parse_stability_param("model.thickness_ratio=0.05:0.25:0.01");
+  const GridAxis t = parse_grid_param("model.thickness_ratio=0.05:0.25:0.01");
   EXPECT_EQ(t.key, kThicknessRatioKey);
   ASSERT_EQ(t.values.size(), 21u);
   EXPECT_EQ(t.values.back(), "0.25");
   // Lists and ranges mix; a stop off the grid is not passed.
-  const StabilityAxis m = parse_stability_param("contact.friction=0.1,0.3:0.5:0.1,0.9");
+  const GridAxis m = parse_grid_param("contact.friction=0.1,0.3:0.5:0.1,0.9");
   EXPECT_EQ(m.values, (std::vector<std::string>{"0.1", "0.3", "0.4", "0.5", "0.9"}));
   EXPECT_EQ(expand_range("0:1:0.3"), (std::vector<std::string>{"0.0", "0.3", "0.6", "0.9"}));
 
   EXPECT_THROW(expand_range("0.2:0.8:0"), DeckError);
   EXPECT_THROW(expand_range("0.8:0.2:0.05"), DeckError);
   EXPECT_THROW(expand_range("0.2:0.8"), DeckError);
-  EXPECT_THROW(parse_stability_param("contact.friction"), DeckError);
-  EXPECT_THROW(parse_stability_param("model.thickness_ratio=-0.1"), DeckError);
+  EXPECT_THROW(parse_grid_param("contact.friction"), DeckError);
+  EXPECT_THROW(parse_grid_param("model.thickness_ratio=-0.1"), DeckError);
 }
 
-TEST(StabilityGrid, ThicknessRatioScalesWithRadius) {
+TEST(Grid, ThicknessRatioScalesWithRadius) {
   std::vector<std::string> sets = kCoarse;
   sets.push_back("model.radius=10");
-  const StabilityGrid g =
-      make_stability_grid(kDeck, sets,
-                          {parse_stability_param("contact.friction=0.3,0.7"),
-                           parse_stability_param("model.thickness_ratio=0.05,0.13")});
+  const Grid g =
+      make_grid(kDeck, sets,
+                          {parse_grid_param("contact.friction=0.3,0.7"),
+                           parse_grid_param("model.thickness_ratio=0.05,0.13")});
   ASSERT_EQ(g.configs.size(), 4u);
   // Row-major, last axis fastest.
   EXPECT_EQ(g.values[1], (std::vector<std::string>{"0.3", "0.13"}));
@@ -121,10 +121,10 @@ TEST(StabilityCell, ThickArchStandsThinArchFalls) {
 }
 
 TEST(StabilityMap, SameResultsOnOneAndTwoThreads) {
-  const StabilityGrid g =
-      make_stability_grid(kDeck, kCoarse,
-                          {parse_stability_param("model.thickness_ratio=0.05,0.25"),
-                           parse_stability_param("contact.friction=0.6,0.8")});
+  const Grid g =
+      make_grid(kDeck, kCoarse,
+                          {parse_grid_param("model.thickness_ratio=0.05,0.25"),
+                           parse_grid_param("contact.friction=0.6,0.8")});
   const StabilityCriteria crit = fast_criteria();
   const std::vector<StabilityCell> one = run_stability_map(g, crit, 1, false, true);
   const std::vector<StabilityCell> two = run_stability_map(g, crit, 2, false, true);

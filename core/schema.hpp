@@ -2,12 +2,26 @@
 // The validated contents of a deck (SPEC.md "Deck keys"). io/deck.cpp fills it from TOML and
 // `--set` overrides; everything downstream reads only this struct, never the TOML.
 // Defaults below are the defaults of a deck that omits the key.
+// The ground header of the project (core/ includes nothing from io/, drivers/ or mesh/): the
+// deck schema and the error types every layer may throw or catch.
 
 #include <array>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace voussoir {
+
+// A bad deck or bad arguments: exit status 2 (the message names the key, the value and what
+// is allowed). Thrown by io/ (the deck reader) and by the set-up that checks deck values.
+struct DeckError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A failure during a run (non-finite state, energy blow-up, a limit): exit status 1.
+struct RunError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 struct ModelConfig {
   std::string kind;                    // required: circular_arch, basket_arch, buttressed_arch,

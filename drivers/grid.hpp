@@ -1,0 +1,43 @@
+#pragma once
+// Grids of deck values for `voussoir sweep` and `voussoir stability`: the `--param` axes
+// (lists and ranges), and the grid of validated decks, row-major with the last axis fastest.
+
+#include <string>
+#include <vector>
+
+#include "core/schema.hpp"
+
+namespace voussoir {
+
+// One axis of a grid, from `--param KEY=V1,V2,...` or `--param KEY=start:stop:step`.
+// The key `model.thickness_ratio` is a convenience: the cell's model.thickness becomes
+// ratio x model.radius (the radius of the cell's deck).
+struct GridAxis {
+  std::string key;
+  std::vector<std::string> values;  // as written to the deck override
+};
+
+inline constexpr const char* kThicknessRatioKey = "model.thickness_ratio";
+
+// Expands "start:stop:step" into decimal strings start, start + step, ... up to stop included
+// when stop lies on the grid (within 1e-9 of a step). Each value is computed as
+// start + i x step and printed with the number of decimals of the inputs, so 0.2:0.8:0.05
+// gives exactly "0.20", "0.25", ..., "0.80" (13 values, no floating drift). Throws DeckError
+// for a non-positive step, stop < start or text that is not three numbers.
+std::vector<std::string> expand_range(const std::string& spec);
+
+// Parses one --param; throws DeckError naming the text when malformed.
+GridAxis parse_grid_param(const std::string& text);
+
+struct Grid {
+  std::vector<GridAxis> axes;
+  std::vector<Config> configs;                   // row-major, last axis fastest
+  std::vector<std::vector<std::string>> values;  // per cell, per axis
+};
+
+// Builds every cell's deck (validated up front, so a bad value stops the map before any
+// work) from the deck file, the --set overrides and the axes.
+Grid make_grid(const std::string& deck_path, const std::vector<std::string>& sets,
+               const std::vector<GridAxis>& axes);
+
+}  // namespace voussoir

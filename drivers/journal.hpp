@@ -1,0 +1,29 @@
+#pragma once
+// The one journal format (capacity's trials, sweep's cells): a file of JSON lines, the first
+// {"fingerprint": "<16 hex digits>"} (core/fnv.hpp over what the records depend on), then one
+// record a line, appended and flushed as each finishes, so a killed command resumes from the
+// records already there. A journal of another fingerprint is refused, never mixed; a line cut
+// by the kill is dropped (its work is done again) and the file rewritten without it.
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace voussoir {
+
+class Journal {
+ public:
+  // An empty path: no journal (nothing read or written). Throws RunError when the file holds
+  // another fingerprint or cannot be written.
+  Journal(const std::string& path, const std::string& fingerprint);
+  const std::vector<nlohmann::json>& records() const { return records_; }
+  // Appends one record (not thread-safe: callers serialise).
+  void append(const nlohmann::json& record);
+
+ private:
+  std::string path_;
+  std::vector<nlohmann::json> records_;
+};
+
+}  // namespace voussoir

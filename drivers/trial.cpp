@@ -1,0 +1,285 @@
+// The engine: one time loop for every run (contract and rules in trial.hpp).
+
+#include "drivers/trial.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "drivers/setup.hpp"
+
+namespace voussoir {
+
+namespace {
+
+// A triangle holding node i (the first one in id order), or -1.
+Index triangle_of_node(const Triangles& t, Index i) {
+  for (Index e = 0; e < t.size(); ++e)
+    if (t.n0[e] == i || t.n1[e] == i || t.n2[e] == i) return e;
+  return -1;
+}
+
+// The free node with the largest speed (a NaN speed counts as the largest), or -1 if none.
+Index fastest_node(const Nodes& n) {
+  Index best = -1;
+  double best_v2 = -1.0;
+  for (Index i = 0; i < n.size(); ++i) {
+    if (n.inv_mass[i] == 0.0) continue;
+    const double v2 = n.vx[i] * n.vx[i] + n.vy[i] * n.vy[i];
+    if (!(v2 <= best_v2)) {  // also takes NaN
+      best = i;
+      best_v2 = v2;
+      if (std::isnan(v2)) break;
+    }
+  }
+  return best;
+}
+
+// "in LABEL at step S (t = T s): node I of block B, triangle E".
+std::string where(const Simulation& sim, Index node, const std::string& label) {
+  std::ostringstream s;
+  s << "in " << label << " at step " << sim.step << " (t = " << sim.ctx.time << " s)";
+  if (node >= 0)
+    s << ": node " << node << " of block " << sim.model.nodes.block[node] << ", triangle "
+      << triangle_of_node(sim.model.tris, node);
+  return s.str();
+}
+
+// The first non-finite quantity of node i, or nullptr.
+const char* non_finite_quantity(const Nodes& n, Index i) {
+  if (!std::isfinite(n.x[i]) || !std::isfinite(n.y[i])) return "position";
+  if (!std::isfinite(n.vx[i]) || !std::isfinite(n.vy[i])) return "velocity";
+  if (!std::isfinite(n.fx[i]) || !std::isfinite(n.fy[i])) return "force";
+  return nullptr;
+}
+
+class FiniteGuard : public StopRule {
+ public:
+  explicit FiniteGuard(const std::string& label) : label_(label) {}
+  std::optional<Verdict> check(const Probe& p) override {
+    check_finite(p.sim, label_);
+    return std::nullopt;
+  }
+
+ private:
+  const std::string& label_;
+};
+
+class EnergyGuard : public StopRule {
+ public:
+  EnergyGuard(const RunLimits& limits, const std::string& label)
+      : limits_(limits), label_(label) {}
+  std::optional<Verdict> check(const Probe& p) override {
+    if (limits_.drift_limit > 0.0 && p.sim.step >= limits_.drift_arm_steps)
+      check_energy_balance(p.sim, limits_.drift_limit, label_);
+    return std::nullopt;
+  }
+
+ private:
+  const RunLimits& limits_;
+  const std::string& label_;
+};
+
+// --max-steps: a budget per run (each settle, trial, pulse run, stability cell or `run`),
+// counted from the run's start and read at its samples, so a run fails at its first sample
+// at or past max_steps steps.
+class MaxStepsGuard : public StopRule {
+ public:
+  MaxStepsGuard(long long max_steps, const std::string& label)
+      : max_steps_(max_steps), label_(label) {}
+  std::optional<Verdict> check(const Probe& p) override {
+    if (max_steps_ <= 0 || p.steps < max_steps_) return std::nullopt;
+    std::ostringstream msg;
+    msg << "step limit --max-steps " << max_steps_ << " reached " << where(p.sim, -1, label_)
+        << " after " << p.steps << " steps of this run";
+    throw RunError(msg.str());
+  }
+
+ private:
+  long long max_steps_;
+  const std::string& label_;
+};
+
+// The guards every run has, built from its limits, read before the classification rules.
+std::vector<std::unique_ptr<StopRule>> make_guards(const RunSpec& spec) {
+  std::vector<std::unique_ptr<StopRule>> guards;
+  guards.push_back(std::make_unique<FiniteGuard>(spec.label));
+  guards.push_back(std::make_unique<EnergyGuard>(spec.limits, spec.label));
+  guards.push_back(std::make_unique<MaxStepsGuard>(spec.limits.max_steps, spec.label));
+  return guards;
+}
+
+}  // namespace
+
+void add_limit_options(CLI::App* cmd, RunLimits& limits) {
+  cmd->add_option("--max-steps", limits.max_steps,
+                  "fail a run (each settle, trial, pulse run or cell) still going after N steps")
+      ->check(CLI::PositiveNumber);
+}
+
+void LoadProgram::apply(Simulation& sim) const {
+  const double t = sim.ctx.time - start;
+  const double g = gravity_ramp > 0.0 ? gravity * std::min(1.0, t / gravity_ramp) : gravity;
+  const double l = lambda_ramp > 0.0 ? lambda * std::min(1.0, t / lambda_ramp) : lambda;
+  double ax = l * gravity;
+  if (signal) ax -= signal->acceleration(sim.ctx.time - signal_start);
+  sim.ctx.body_ax = ax;
+  sim.ctx.body_ay = -g;
+}
+
+MotionExtent largest_motion(const Model& model, const std::vector<BlockMotion>& base) {
+  const std::vector<BlockMotion> now = block_motions(model);
+  MotionExtent m;
+  for (size_t b = 0; b < now.size(); ++b) {
+    if (model.blocks[b].fixed) continue;
+    m.displacement =
+        std::max(m.displacement, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
+    m.rotation = std::max(m.rotation, std::abs(now[b].rotation - base[b].rotation));
+  }
+  return m;
+}
+
+std::optional<Verdict> CollapseRule::check(const Probe& p) {
+  if (p.motion.displacement > d_) return Verdict{true, d_reason_};
+  if (p.motion.rotation > rot_) return Verdict{true, rot_reason_};
+  return std::nullopt;
+}
+
+std::optional<Verdict> RestRule::check(const Probe& p) {
+  if (p.time < from_) return std::nullopt;
+  if (detector_.update(p.time, p.speed, p.sim.ledger.kinetic)) return Verdict{false, "rest"};
+  return std::nullopt;
+}
+
+std::optional<Verdict> TrendRule::check(const Probe& p) {
+  if (p.time >= measure_from_)
+    measure_.push_back(std::max(p.motion.displacement / d_, p.motion.rotation / rot_));
+  if (p.time < from_ || p.time < limit_ || measure_.empty()) return std::nullopt;
+  const size_t cut = measure_.size() * 2 / 3;
+  const double earlier = *std::max_element(measure_.begin(), measure_.begin() + cut + 1);
+  return Verdict{measure_.back() > 1.1 * earlier, "timeout"};
+}
+
+Outcome run_engine(Simulation& sim, RunSpec& spec) {
+  using clock = std::chrono::steady_clock;
+  const auto wall0 = clock::now();
+  const double dt = sim.ctx.dt;
+  if (!(dt > 0.0) || !std::isfinite(dt)) {
+    std::ostringstream msg;
+    msg << spec.label << ": cannot run with a time step of " << dt << " s";
+    throw RunError(msg.str());
+  }
+  const double t_start = sim.ctx.time;
+  const long long step_start = sim.step;
+  const long long origin = spec.sample_origin >= 0 ? spec.sample_origin : step_start;
+  const long long every =
+      std::max(1LL, static_cast<long long>(std::llround(std::min(spec.sample_every / dt, 1e15))));
+  const std::vector<BlockMotion> base =
+      spec.track_motion && spec.motion_base.empty() ? block_motions(sim.model) : spec.motion_base;
+  std::vector<std::unique_ptr<StopRule>> guards = make_guards(spec);
+  ProgressTicker ticker(spec.quiet);
+  double next_progress = spec.progress_period;
+
+  Outcome out;
+  auto clock_probe = [&] {  // time and steps only: what the guards read
+    Probe p(sim);
+    p.time = sim.ctx.time - t_start;
+    p.steps = sim.step - step_start;
+    return p;
+  };
+  auto probe_now = [&] {
+    Probe p = clock_probe();
+    if (spec.track_motion) p.motion = largest_motion(sim.model, base);
+    p.speed = max_free_speed(sim.model.nodes);
+    return p;
+  };
+  if (spec.sample_at_start && spec.on_sample && !spec.on_sample(sim, probe_now())) {
+    out.steps = 0;
+    out.wall_s = seconds_since(wall0);
+    return out;
+  }
+  for (;;) {
+    if (spec.end_step >= 0 && sim.step >= spec.end_step) break;
+    if (!(sim.ctx.time - t_start < spec.end_time)) break;
+    if (spec.loads) spec.loads->apply(sim);
+    advance(sim);
+    StepInfo info;
+    info.last = spec.end_step >= 0 && sim.step == spec.end_step;
+    info.sample = (sim.step - origin) % every == 0;
+    if (spec.on_step) spec.on_step(sim, info);
+    if (!info.sample && !(info.last && spec.sample_last)) {
+      // The last step of a run that ends off the sample grid is still guarded.
+      const bool ends = info.last || !(sim.ctx.time - t_start < spec.end_time);
+      if (ends)
+        for (auto& g : guards) g->check(clock_probe());
+      continue;
+    }
+    for (auto& g : guards) g->check(clock_probe());
+    const Probe p = probe_now();
+    out.sample_time = p.time;
+    out.motion = p.motion;
+    out.peak_motion.displacement = std::max(out.peak_motion.displacement, p.motion.displacement);
+    out.peak_motion.rotation = std::max(out.peak_motion.rotation, p.motion.rotation);
+    const bool go_on = spec.on_sample ? spec.on_sample(sim, p) : true;
+    if (!out.decided)
+      for (auto& rule : spec.rules)
+        if (const std::optional<Verdict> v = rule->check(p)) {
+          out.decided = true;
+          out.collapsed = v->collapsed;
+          out.reason = v->reason;
+          out.decided_at = p.time;
+          break;
+        }
+    if (!spec.quiet && spec.progress && ticker.wall() >= next_progress) {
+      next_progress += spec.progress_period;
+      spec.progress(p, ticker.wall());
+    }
+    if (!go_on || (out.decided && p.time >= spec.min_time)) break;
+  }
+  out.time = sim.ctx.time - t_start;
+  out.steps = sim.step - step_start;
+  out.wall_s = seconds_since(wall0);
+  return out;
+}
+
+void check_finite(const Simulation& sim, const std::string& label) {
+  const Nodes& n = sim.model.nodes;
+  for (Index i = 0; i < n.size(); ++i) {
+    const char* what = non_finite_quantity(n, i);
+    if (!what) continue;
+    throw RunError(std::string("non-finite ") + what + " " + where(sim, i, label) +
+                   " (the time step may be too large for the contact penalty; try a smaller "
+                   "solver.dt_safety)");
+  }
+  const EnergyLedger& l = sim.ledger;
+  const std::pair<const char*, double> energies[] = {
+      {"kinetic energy", l.kinetic},
+      {"strain energy", l.strain},
+      {"contact energy", l.contact},
+      {"external work", l.external_work},
+      {"damping dissipation", l.damping_dissipated},
+      {"friction dissipation", l.friction_dissipated},
+      {"peak energy", l.max_energy}};
+  for (const auto& [name, e] : energies) {
+    if (std::isfinite(e)) continue;
+    throw RunError(std::string("non-finite ") + name + " " + where(sim, fastest_node(n), label) +
+                   " (the fastest node; the loads or the material may be out of range)");
+  }
+}
+
+void check_energy_balance(const Simulation& sim, double limit, const std::string& label) {
+  const double err = sim.ledger.balance_error();
+  if (!(err > limit)) return;
+  const EnergyLedger& l = sim.ledger;
+  std::ostringstream msg;
+  msg << "energy balance error " << err << " above the limit " << limit << " "
+      << where(sim, fastest_node(sim.model.nodes), label) << " (the fastest node): external work "
+      << l.external_work << " J, kinetic " << l.kinetic << " J, strain " << l.strain
+      << " J, contact " << l.contact << " J, dissipated " << l.dissipated()
+      << " J (the time step may be too large; try a smaller solver.dt_safety)";
+  throw RunError(msg.str());
+}
+
+}  // namespace voussoir

@@ -1,0 +1,206 @@
+#pragma once
+// The engine: the one time loop of drivers/ (docs/engine.md). It advances a Simulation under a
+// load program and a list of stop rules and returns the outcome with its reason. `voussoir
+// run` (run_loop, drivers/run.hpp), the settle under gravity and the capacity trials
+// (drivers/capacity.cpp), the pulse runs (drivers/pulse.cpp) and the stability cells
+// (drivers/stability.cpp) are configurations of it.
+//
+// One step of the engine:
+//   1. end of the run?  the step limit `end_step` or the time limit `end_time` (checked before
+//      every step, so a run ends at the first step that reaches them);
+//   2. loads: the load program sets ctx.body_ax/ay from the simulation time (LoadProgram);
+//   3. advance(sim) (core/step.hpp), then the on_step hook (recorders, checkpoints);
+//   4. at a sample (every `sample_every` of simulated time, counted in whole steps from
+//      `sample_origin`): the guards (non-finite state, energy balance, the user's limits:
+//      RunLimits), then the on_sample hook, then the stop rules in order until one decides.
+//      A decided run ends there, unless `min_time` asks it to go on (sampled, not re-decided).
+//
+// Guards throw RunError (exit status 1) naming the run (RunSpec::label), the step, the time,
+// the quantity and where (node, block, triangle). They are on in every run; tests may switch
+// the energy guard off (RunLimits::drift_limit <= 0).
+//
+// Stop rules are small objects read at samples, never inside the step (a virtual call every
+// millisecond of simulated time costs nothing against the step). The classification rules:
+//   CollapseRule  collapsed when a free block's centroid moved more than d_limit or rotated
+//                 more than rot_limit since the start of the run;
+//   RestRule      stable when the largest free-node speed has stayed below v_rest for the hold
+//                 window (RestDetector, drivers/motion.hpp), from run time `from` on;
+//   TrendRule     at run time `limit` (and not before `from`): collapsed when the motion
+//                 measure max(d / d_scale, rot / rot_scale) now exceeds by 10% its largest
+//                 value over the first two thirds of the samples since `measure_from`, stable
+//                 otherwise (critical slowing down near a threshold: a mechanism that keeps
+//                 opening against an oscillation about a displaced equilibrium).
+// The guards and the user's limits (RunLimits) are built by the engine itself, so that every
+// run has them and a new limit is one field and one rule here.
+
+#include <functional>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base_motion.hpp"
+#include "core/step.hpp"
+#include "drivers/kinematics.hpp"
+#include "drivers/motion.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace voussoir {
+
+// Largest balance error of the energy ledger a run may reach (dimensionless, relative to the
+// peak energy; the study is in drivers/run.hpp).
+inline constexpr double kEnergyDriftLimit = 0.05;
+// Steps after which the energy guard is armed (drivers/run.hpp).
+inline constexpr long long kEnergyDriftArmSteps = 1000;
+
+// The loads of a run as functions of the simulation time t (SPEC.md section 1, "Loads"):
+//   body_ay = -g r_g(t),  body_ax = lambda r_l(t) g - a_g(t - signal_start)
+// with the ramps r(t) = min(1, (t - start) / ramp) (1 when the ramp is 0) and a_g the base
+// signal in m/s2 (none when `signal` is null). Evaluated once per step, before it.
+struct LoadProgram {
+  double gravity = 9.81;               // g [m/s2]
+  double gravity_ramp = 0.0;           // [s]; 0 = full gravity from the start
+  double lambda = 0.0;                 // horizontal load factor
+  double lambda_ramp = 0.0;            // [s]; 0 = full lambda g from the start
+  double start = 0.0;                  // simulation time at which the ramps start [s]
+  const BaseSignal* signal = nullptr;  // base acceleration (owned by the caller), or none
+  double signal_start = 0.0;           // simulation time of signal time 0 [s]
+
+  // Sets ctx.body_ax and ctx.body_ay for the step that starts at ctx.time.
+  void apply(Simulation& sim) const;
+};
+
+// Largest centroid displacement [m] and rotation [rad] of the free blocks since a reference.
+struct MotionExtent {
+  double displacement = 0.0, rotation = 0.0;
+};
+
+// Largest motion of the free blocks of `model` since the block motions `base`.
+MotionExtent largest_motion(const Model& model, const std::vector<BlockMotion>& base);
+
+// What the hooks and rules read at a sample.
+struct Probe {
+  explicit Probe(const Simulation& s) : sim(s) {}
+  const Simulation& sim;
+  double time = 0.0;     // run time: simulated time since the start of the run [s]
+  long long steps = 0;   // steps since the start of the run
+  MotionExtent motion;   // since the start of the run (when RunSpec::track_motion)
+  double speed = 0.0;    // largest free-node speed [m/s]
+};
+
+struct Verdict {
+  bool collapsed = false;
+  std::string reason;  // "displacement", "rotation", "fall", "rest", "timeout"
+};
+
+class StopRule {
+ public:
+  virtual ~StopRule() = default;
+  // Reads one sample; a verdict ends the run (classified), a RunError fails it.
+  virtual std::optional<Verdict> check(const Probe& p) = 0;
+};
+
+class CollapseRule : public StopRule {
+ public:
+  CollapseRule(double d_limit, double rot_limit, std::string d_reason = "displacement",
+               std::string rot_reason = "rotation")
+      : d_(d_limit), rot_(rot_limit), d_reason_(std::move(d_reason)),
+        rot_reason_(std::move(rot_reason)) {}
+  std::optional<Verdict> check(const Probe& p) override;
+
+ private:
+  double d_, rot_;
+  std::string d_reason_, rot_reason_;
+};
+
+class RestRule : public StopRule {
+ public:
+  // require_decay: RestDetector's growth check (off for the pulses: speed alone).
+  RestRule(double v_rest, double hold, double from, bool require_decay = true)
+      : detector_(v_rest, hold, require_decay), from_(from) {}
+  std::optional<Verdict> check(const Probe& p) override;
+
+ private:
+  RestDetector detector_;
+  double from_;
+};
+
+class TrendRule : public StopRule {
+ public:
+  TrendRule(double d_scale, double rot_scale, double measure_from, double from, double limit)
+      : d_(d_scale), rot_(rot_scale), measure_from_(measure_from), from_(from), limit_(limit) {}
+  std::optional<Verdict> check(const Probe& p) override;
+
+ private:
+  double d_, rot_, measure_from_, from_, limit_;
+  std::vector<double> measure_;
+};
+
+// Limits the user or a test sets on every run; the engine turns them into guard rules.
+struct RunLimits {
+  double drift_limit = kEnergyDriftLimit;            // <= 0: energy guard off
+  long long drift_arm_steps = kEnergyDriftArmSteps;  // energy guard from this absolute step on
+  long long max_steps = 0;  // --max-steps N: a run still going after N steps fails; 0 = none
+};
+
+// The engine's options for every command that runs (run, capacity, sweep, pulse, stability).
+void add_limit_options(CLI::App* cmd, RunLimits& limits);
+
+// Where the engine reports a step.
+struct StepInfo {
+  bool sample = false;  // this step is on the sample grid
+  bool last = false;    // this step reaches end_step
+};
+
+struct RunSpec {
+  std::string label = "run";               // names the run in errors and progress lines
+  std::optional<LoadProgram> loads;        // none: ctx.body_ax/ay are left as they are
+  std::vector<std::unique_ptr<StopRule>> rules;  // in order; the first verdict decides
+  RunLimits limits;
+  double sample_every = kSampleTime;       // [s], rounded to whole steps (at least one)
+  long long sample_origin = -1;            // samples on steps origin + k every; -1: the start
+  bool sample_at_start = false;            // on_sample before the first step (no rules)
+  bool sample_last = false;                // a sample at end_step even off the grid
+  long long end_step = -1;                 // absolute step at which the run ends; -1: none
+  double end_time = std::numeric_limits<double>::infinity();  // run time limit [s]
+  double min_time = 0.0;                   // a decided run goes on to this run time [s]
+  bool track_motion = false;               // compute Probe::motion at samples
+  std::vector<BlockMotion> motion_base;    // reference of Probe::motion; empty: the start
+  std::function<void(const Simulation&, const StepInfo&)> on_step;
+  std::function<bool(const Simulation&, const Probe&)> on_sample;  // false: stop the run
+  // Progress on stderr every progress_period of wall time unless quiet.
+  bool quiet = true;
+  double progress_period = kProgressPeriod;  // [s] wall
+  std::function<void(const Probe&, double wall_s)> progress;
+};
+
+struct Outcome {
+  bool decided = false;
+  bool collapsed = false;
+  std::string reason;         // the verdict's; "" when a limit or on_sample ended the run
+  double time = 0.0;          // run time at the end [s]
+  double sample_time = 0.0;   // run time of the last sample [s]
+  double decided_at = 0.0;    // run time of the verdict [s]
+  long long steps = 0;        // steps run
+  double wall_s = 0.0;
+  MotionExtent motion;        // at the last sample
+  MotionExtent peak_motion;   // largest over the samples
+};
+
+// Runs `spec` on `sim` (header comment). Throws RunError from the guards.
+Outcome run_engine(Simulation& sim, RunSpec& spec);
+
+// Throws RunError naming the run `label`, the step, time, quantity, block and triangle when any
+// node position, velocity or force, or any energy of the ledger, is not finite.
+void check_finite(const Simulation& sim, const std::string& label = "run");
+
+// Throws RunError naming the run, step, time and the fastest node (its block and a triangle)
+// when sim.ledger.balance_error() exceeds `limit`.
+void check_energy_balance(const Simulation& sim, double limit = kEnergyDriftLimit,
+                          const std::string& label = "run");
+
+}  // namespace voussoir
