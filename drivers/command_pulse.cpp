@@ -49,7 +49,7 @@ SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {
   r.kinetic = l.kinetic;
   r.strain = l.strain;
   r.contact = l.contact;
-  r.damping_dissipated = l.damping_dissipated;
+  r.damping_dissipated = l.damping_dissipated + l.impact_dissipated;  // io/hdf5_output.hpp
   r.friction_dissipated = l.friction_dissipated;
   r.external_work = l.external_work;
   r.max_displacement = max_free_displacement(sim.model);

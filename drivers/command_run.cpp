@@ -35,7 +35,7 @@ SeriesRecord series_record(const Simulation& sim) {
   r.kinetic = l.kinetic;
   r.strain = l.strain;
   r.contact = l.contact;
-  r.damping_dissipated = l.damping_dissipated;
+  r.damping_dissipated = l.damping_dissipated + l.impact_dissipated;  // io/hdf5_output.hpp
   r.friction_dissipated = l.friction_dissipated;
   r.external_work = l.external_work;
   r.max_displacement = max_free_displacement(sim.model);
@@ -225,6 +225,7 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
                           {"contact", sim.ledger.contact},
                           {"damping_dissipated", sim.ledger.damping_dissipated},
                           {"friction_dissipated", sim.ledger.friction_dissipated},
+                          {"impact_dissipated", sim.ledger.impact_dissipated},
                           {"external_work", sim.ledger.external_work}}},
                         {"active_contacts", sim.contact.active_pairs()},
                         {"max_active_contacts", stats.max_active_pairs},

@@ -261,6 +261,7 @@ void check_finite(const Simulation& sim, const std::string& label) {
       {"external work", l.external_work},
       {"damping dissipation", l.damping_dissipated},
       {"friction dissipation", l.friction_dissipated},
+      {"impact dissipation", l.impact_dissipated},
       {"peak energy", l.max_energy}};
   for (const auto& [name, e] : energies) {
     if (std::isfinite(e)) continue;

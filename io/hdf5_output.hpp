@@ -51,7 +51,8 @@ struct SeriesRecord {
   double kinetic = 0.0;               // [J] (per the model's out_of_plane thickness)
   double strain = 0.0;                // [J]
   double contact = 0.0;               // [J] penalty energy stored in overlaps
-  double damping_dissipated = 0.0;    // [J] cumulative
+  double damping_dissipated = 0.0;    // [J] cumulative: element damping and, for rigid
+                                      // blocks, the contacts' impact damping
   double friction_dissipated = 0.0;   // [J] cumulative
   double external_work = 0.0;         // [J] cumulative (gravity, lambda g, base motion)
   double max_displacement = 0.0;      // [m] largest free-node displacement magnitude
