@@ -14,6 +14,7 @@
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/trial.hpp"
+#include "io/accelerogram.hpp"
 
 namespace voussoir {
 namespace {

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "drivers/pulse.hpp"
+#include "io/accelerogram.hpp"
 #include "io/deck.hpp"
 #include "mesh/scene.hpp"
 
