@@ -32,7 +32,7 @@ std::string case_path(const std::string& name) {
 }
 
 Model case_model(const std::string& name, const std::vector<std::string>& sets = {}) {
-  return build_model(load_deck(case_path(name), sets));
+  return build_model(scene_params(load_deck(case_path(name), sets)));
 }
 
 // A width x height rectangle at (x0, y0) as one block, its sides cut into nx and ny pieces
