@@ -16,6 +16,7 @@
 
 #include "core/scene_kinds.hpp"
 #include "io/deck.hpp"
+#include "mesh/rectangle.hpp"
 #include "mesh/scene.hpp"
 #include "mesh/scene_spec.hpp"
 
@@ -624,6 +625,33 @@ TEST(SceneKinds, TheDeckReaderAndTheBuilderFollowTheRegistry) {
   }
   EXPECT_FALSE(is_arch_kind("no_such_kind"));
   EXPECT_EQ(find_scene_kind("no_such_kind"), nullptr);
+}
+
+TEST(GridRectangle, LayoutDiagonalsAndOutline) {
+  // mesh/rectangle.hpp: node (i, j) at index j (nx + 1) + i; cell (1, 0) of the alternating
+  // grid takes the other diagonal; both patterns tile the rectangle; the outline is the four
+  // corners or every boundary node.
+  const TriMesh alt = mesh_grid_rectangle(1.0, 2.0, 2.0, 1.0, 2, 1);
+  const TriMesh uni = mesh_grid_rectangle(1.0, 2.0, 2.0, 1.0, 2, 1, GridDiagonals::Uniform);
+  ASSERT_EQ(alt.points.size(), 6u);
+  EXPECT_EQ(alt.points[4].x, 2.0);
+  EXPECT_EQ(alt.points[4].y, 3.0);
+  ASSERT_EQ(alt.tris.size(), 4u);
+  EXPECT_EQ(alt.tris[2], (std::array<Index, 3>{1, 2, 4}));
+  EXPECT_EQ(uni.tris[2], (std::array<Index, 3>{1, 2, 5}));
+  for (const TriMesh* m : {&alt, &uni}) {
+    double area = 0.0;
+    for (const auto& t : m->tris)
+      area += std::abs(polygon_area({m->points[t[0]], m->points[t[1]], m->points[t[2]]}));
+    EXPECT_DOUBLE_EQ(area, 2.0);
+  }
+  Model model;
+  add_grid_rectangle(model, 0.0, 0.0, 2.0, 1.0, 2, 1, false, "a");
+  add_grid_rectangle(model, 0.0, 1.0, 2.0, 1.0, 2, 1, true, "b", GridDiagonals::Uniform,
+                     GridOutline::Nodes);
+  EXPECT_EQ(model.blocks[0].polygon.size(), 4u);
+  EXPECT_EQ(model.blocks[1].polygon.size(), 6u);
+  EXPECT_TRUE(model.blocks[1].fixed);
 }
 
 }  // namespace
