@@ -24,7 +24,7 @@ using namespace voussoir;
 // nx x ny cells of 0.01 m, two triangles each.
 Simulation make_rectangle_sim(int nx, int ny, double damping_factor) {
   Simulation sim;
-  bench::add_grid_block(sim.model, 0.0, 0.0, 0.01 * nx, 0.01 * ny, nx, ny, false, "bench");
+  add_grid_rectangle(sim.model, 0.0, 0.0, 0.01 * nx, 0.01 * ny, nx, ny, false, "bench");
   finalize_model(sim.model);
   sim.ctx.contact_on = false;
   sim.ctx.body_ax = 0.0;

@@ -95,8 +95,8 @@ int main() {
   omp_set_num_threads(1);
   std::printf("CPU ns per triangle, as built -> after order_for_locality (one thread)\n");
   Model rect;
-  bench::add_grid_block(rect, 0.0, 0.0, 1.6, 3.2, 160, 320, false, "block");
-  bench::add_grid_block(rect, -0.1, -0.2, 1.8, 0.2, 4, 1, true, "ground");
+  add_grid_rectangle(rect, 0.0, 0.0, 1.6, 3.2, 160, 320, false, "block");
+  add_grid_rectangle(rect, -0.1, -0.2, 1.8, 0.2, 4, 1, true, "ground");
   finalize_model(rect);
   compare("rect", rect);
   Model shuffled = rect;

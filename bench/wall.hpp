@@ -1,7 +1,7 @@
 #pragma once
 // The large benchmark structure of docs/benchmarks.md: a dry-stone wall in running bond on a
-// fixed ground slab, built with add_block. Blocks 0.4 m x 0.2 m, each meshed as a structured
-// grid of cells_x x cells_y cells (two triangles each, alternating diagonals); odd courses are
+// fixed ground slab. Blocks 0.4 m x 0.2 m, each a gridded rectangle (mesh/rectangle.hpp) of
+// cells_x x cells_y cells (two triangles each, alternating diagonals); odd courses are
 // shifted by half a block and end with half blocks. Material of cases/circular_arch.toml
 // (E 40 GPa, nu 0.2, rho 2000), friction 0.6, default penalty (100 x Lame lambda) and
 // damping (factor 1), gravity, dt = 0.5 x the stable step.
@@ -13,46 +13,25 @@
 
 #include "core/model.hpp"
 #include "core/step.hpp"
+#include "mesh/rectangle.hpp"
 
 namespace voussoir::bench {
-
-// One block [x0, x0 + w] x [y0, y0 + h] meshed in cx x cy cells.
-inline void add_grid_block(Model& m, double x0, double y0, double w, double h, int cx, int cy,
-                           bool fixed, const char* role) {
-  std::vector<Vec2> points;
-  for (int j = 0; j <= cy; ++j)
-    for (int i = 0; i <= cx; ++i) points.push_back({x0 + w * i / cx, y0 + h * j / cy});
-  auto id = [cx](int i, int j) { return Index(j * (cx + 1) + i); };
-  std::vector<std::array<Index, 3>> tris;
-  for (int j = 0; j < cy; ++j)
-    for (int i = 0; i < cx; ++i) {
-      if ((i + j) % 2 == 0) {
-        tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      } else {
-        tris.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
-        tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-    }
-  const std::vector<Vec2> outline = {{x0, y0}, {x0 + w, y0}, {x0 + w, y0 + h}, {x0, y0 + h}};
-  add_block(m, outline, points, tris, fixed, role);
-}
 
 inline Model wall_model(int courses, int per_course, int cells_x, int cells_y) {
   const double w = 0.4, h = 0.2, length = w * per_course;
   Model m;
   m.kind = "wall";
-  add_grid_block(m, -0.2, -0.2, length + 0.4, 0.2, 2 * cells_x, cells_y, true, "ground");
+  add_grid_rectangle(m, -0.2, -0.2, length + 0.4, 0.2, 2 * cells_x, cells_y, true, "ground");
   for (int c = 0; c < courses; ++c) {
     const double y = h * c;
     if (c % 2 == 0) {
       for (int b = 0; b < per_course; ++b)
-        add_grid_block(m, w * b, y, w, h, cells_x, cells_y, false, "block");
+        add_grid_rectangle(m, w * b, y, w, h, cells_x, cells_y, false, "block");
     } else {  // half block, per_course - 1 whole blocks, half block
-      add_grid_block(m, 0.0, y, 0.5 * w, h, cells_x / 2, cells_y, false, "block");
+      add_grid_rectangle(m, 0.0, y, 0.5 * w, h, cells_x / 2, cells_y, false, "block");
       for (int b = 0; b + 1 < per_course; ++b)
-        add_grid_block(m, 0.5 * w + w * b, y, w, h, cells_x, cells_y, false, "block");
-      add_grid_block(m, length - 0.5 * w, y, 0.5 * w, h, cells_x / 2, cells_y, false, "block");
+        add_grid_rectangle(m, 0.5 * w + w * b, y, w, h, cells_x, cells_y, false, "block");
+      add_grid_rectangle(m, length - 0.5 * w, y, 0.5 * w, h, cells_x / 2, cells_y, false, "block");
     }
   }
   finalize_model(m);

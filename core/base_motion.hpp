@@ -22,8 +22,9 @@
 //                  (1 cycle, even cycles): then the table ends displaced, at rest.
 //   sine_pulse     a_g(t) = A sin(2 pi f t) for 0 <= t <= 1/f (one full cycle), 0 after;
 //                  v(t) = A / (2 pi f) (1 - cos 2 pi f t): v(1/f) = 0, d(1/f) = A / (2 pi f^2).
-//   file           two columns (time [s], acceleration [g or m/s2]); linear interpolation
-//                  between samples, zero before the first and after the last sample.
+//   file           two columns (time [s], acceleration [g or m/s2]), read by io/accelerogram;
+//                  linear interpolation between samples, zero before the first and after
+//                  the last sample.
 //
 // Evaluation cost. The analytic signals are evaluated from their formula at every step (two
 // sines and a cosine: nothing next to a step of the element and contact stages, and exact at
@@ -51,14 +52,16 @@
 // signal keeps that tail (it is part of the zero-phase response) and starts at t = 0 (what the
 // backward pass puts before t = 0 is dropped: records start with a quiet pre-event memory).
 // Only file signals are filtered (the analytic pulses are already band-limited); a band given
-// with an analytic signal is refused by make_base_signal.
+// with an analytic signal is refused by make_base_signal (io/accelerogram.hpp).
+//
+// This file is signal math on arrays only: it reads no file and throws nothing. Reading the
+// record, checking the deck's [load.base] and the band against the record are io/'s
+// (io/accelerogram.hpp), which hands BaseSignal::table the samples.
 
 #include <cmath>
 #include <numbers>
 #include <string>
 #include <vector>
-
-#include "core/schema.hpp"
 
 namespace voussoir {
 
@@ -103,23 +106,17 @@ std::vector<Biquad> butterworth4(double fc, double dt, bool high_pass);
 // Gain |H| of a cascade of sections at frequency f [Hz] (one pass, not forward-backward).
 double cascade_gain(const std::vector<Biquad>& sections, double f, double dt);
 
-// An accelerogram as read from a file: times [s] strictly increasing, accelerations [m/s2].
+// An accelerogram: times [s] strictly increasing, accelerations [m/s2] (read from a file by
+// io/accelerogram.hpp).
 struct Accelerogram {
   std::vector<double> time;
   std::vector<double> accel;
 };
 
-// Parses the text of an accelerogram: one sample per line, two numbers (time, acceleration)
-// separated by a comma and/or whitespace; '#' starts a comment; blank lines are skipped.
-// `units` is "g" (multiplied by `gravity`) or "m/s2". Throws DeckError naming `source`, the
-// line and what is wrong (not two numbers, non-finite, time not increasing, fewer than two
-// samples). (An edge function: the only throwing code in this file, kept here beside the
-// signal it feeds.)
-Accelerogram parse_accelerogram(const std::string& text, const std::string& source,
-                                const std::string& units, double gravity);
-
-// Reads and parses the file (DeckError if it cannot be read).
-Accelerogram read_accelerogram(const std::string& path, const std::string& units, double gravity);
+// Uniform resampling interval [s] of a record for BaseSignal::table: its smallest time
+// increment, at most 1 / (10 band_hi) when filtering (band_hi > 0), and coarse enough for
+// the largest table (4e6 samples).
+double resample_spacing(const Accelerogram& record, double band_hi);
 
 // The base acceleration a_g(t) [m/s2] of one run, with the table velocity and displacement.
 class BaseSignal {
@@ -187,17 +184,5 @@ class BaseSignal {
   std::vector<double> acc_;         // a_g at t_k = k h [m/s2]
   std::vector<double> vel_, disp_;  // table velocity and displacement at t_k
 };
-
-// The signal of a deck's [load.base] with amplitude `amplitude_g` [g] and frequency [Hz] (the
-// deck values unless a driver overrides them, e.g. `pulse --curve`); `gravity` [m/s2] converts
-// g to m/s2. A file record is used as read when the amplitude is 0 (the deck default) and
-// otherwise scaled to that peak |a_g| (its PGA), sign included; frequency does not apply to it.
-// Reads and filters the file for signal = "file". Throws DeckError for a band given with an
-// analytic signal, a band above the Nyquist frequency of the resampled record, or a bad file.
-BaseSignal make_base_signal(const BaseConfig& base, double amplitude_g, double frequency,
-                            double gravity);
-inline BaseSignal make_base_signal(const BaseConfig& base, double gravity) {
-  return make_base_signal(base, base.amplitude, base.frequency, gravity);
-}
 
 }  // namespace voussoir

@@ -134,4 +134,19 @@ struct Config {
   OutputConfig output;
 };
 
+// What the scene generators (mesh/) read of a deck: its [model], [mesh] and [material]
+// sections and where the deck is (named in messages; relative model.file is resolved against
+// deck_dir). mesh/ takes this, never the whole Config.
+struct SceneParams {
+  std::string deck_path;
+  std::string deck_dir;
+  ModelConfig model;
+  MeshConfig mesh;
+  MaterialConfig material;
+};
+
+inline SceneParams scene_params(const Config& c) {
+  return {c.deck_path, c.deck_dir, c.model, c.mesh, c.material};
+}
+
 }  // namespace voussoir

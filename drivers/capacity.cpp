@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/fnv.hpp"
+#include "drivers/bracket.hpp"
 #include "drivers/journal.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
@@ -230,18 +231,14 @@ int unseeded_trial_count(double lambda_star, double lambda_min, double tolerance
     }
   }
   if (!have_hi) return trials;
-  while (hi - lo > tolerance * hi) {
-    double new_lo = lo, new_hi = hi;
-    for (int i = 1; i <= points; ++i) {
-      const double l = lo + (hi - lo) * i / (points + 1);
-      ++trials;
-      if (l > lambda_star) new_hi = std::min(new_hi, l);
-      else new_lo = std::max(new_lo, l);
-    }
-    lo = new_lo;
-    hi = new_hi;
-  }
-  return trials;
+  Bracket b{lo, hi};
+  auto oracle = [lambda_star](const std::vector<double>& probes) {
+    std::vector<bool> crossed;
+    for (double l : probes) crossed.push_back(l > lambda_star);
+    return crossed;
+  };
+  return trials + shrink_bracket(b, tolerance, points, ProbePlacement::KSection, oracle,
+                                 [](const Bracket&) {});
 }
 
 CapacityResult find_capacity(const Config& config, const TrialCriteria& crit, int points,
@@ -396,19 +393,20 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     return res;
   }
 
-  // k-section: `points` interior lambdas per round. The lowest collapse is the new upper bound
-  // and the highest stable trial below it the new lower bound (a stable trial above a collapsed
-  // one, a non-monotone response near the threshold, is ignored).
-  while (hi - lo > res.tolerance * hi) {
-    std::vector<double> lambdas;
-    for (int i = 1; i <= points; ++i) lambdas.push_back(lo + (hi - lo) * i / (points + 1));
-    const auto round = evaluate(lambdas);
-    for (const TrialResult& r : round)
-      if (r.collapsed) hi = std::min(hi, r.lambda);
-    for (const TrialResult& r : round)
-      if (!r.collapsed && r.lambda < hi) lo = std::max(lo, r.lambda);
-    if (!quiet) std::fprintf(stderr, "bracket [%.5f, %.5f]\n", lo, hi);
-  }
+  // k-section (drivers/bracket.hpp): `points` interior lambdas per round, run in parallel.
+  Bracket bracket{lo, hi};
+  shrink_bracket(
+      bracket, res.tolerance, points, ProbePlacement::KSection,
+      [&](const std::vector<double>& lambdas) {
+        std::vector<bool> collapsed;
+        for (const TrialResult& r : evaluate(lambdas)) collapsed.push_back(r.collapsed);
+        return collapsed;
+      },
+      [&](const Bracket& b) {
+        if (!quiet) std::fprintf(stderr, "bracket [%.5f, %.5f]\n", b.lo, b.hi);
+      });
+  lo = bracket.lo;
+  hi = bracket.hi;
   for (const TrialResult& r : res.trials) {
     if (!r.collapsed || r.lambda != hi) continue;
     res.hinges = r.hinges;

@@ -69,7 +69,7 @@ nlohmann::json interfaces_json(const LimitResult& res) {
 int command_limit(const Config& config, const CommonOptions& common,
                   const LimitCommandOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Model model = build_model(config);
+  const Model model = build_model(scene_params(config));
   const double model_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double mu = config.contact.friction;

@@ -17,6 +17,7 @@
 #include "drivers/pulse.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "io/accelerogram.hpp"
 #include "io/deck.hpp"
 #include "io/hdf5_output.hpp"
 #include "io/json.hpp"

@@ -10,10 +10,12 @@
 #include <cstdio>
 #include <limits>
 
+#include "drivers/bracket.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/trial.hpp"
+#include "io/accelerogram.hpp"
 
 namespace voussoir {
 namespace {
@@ -284,15 +286,16 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     }
   }
   cp.bracketed = have_hi;
-  if (have_hi) {
-    while (hi - lo > tolerance * hi) {
-      const double mid = 0.5 * (lo + hi);
-      if (trial(mid)) {
-        hi = mid;
-      } else {
-        lo = mid;
-      }
-    }
+  if (have_hi) {  // bisection (drivers/bracket.hpp)
+    Bracket b{lo, hi};
+    shrink_bracket(
+        b, tolerance, 1, ProbePlacement::Midpoint,
+        [&](const std::vector<double>& amplitudes) {
+          return std::vector<bool>{trial(amplitudes[0])};
+        },
+        [](const Bracket&) {});
+    lo = b.lo;
+    hi = b.hi;
   }
   cp.lo = lo;
   cp.hi = have_hi ? hi : lo;

@@ -26,7 +26,7 @@ void set_static_load(Simulation& sim, double gravity, double lambda) {
 
 Simulation make_simulation(const Config& config, SetupInfo* info) {
   Simulation sim;
-  sim.model = build_model(config);
+  sim.model = build_model(scene_params(config));
   const bool rigid = config.material.model == "rigid";
   if (rigid) {
     // Only the outline matters to a rigid block: the fewest triangles (mesh/minimal.hpp).

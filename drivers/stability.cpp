@@ -14,6 +14,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/scene_kinds.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
@@ -27,14 +28,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool is_arch(const std::string& kind) {
-  return kind == "circular_arch" || kind == "basket_arch" || kind == "buttressed_arch";
-}
-
 }  // namespace
 
 double stability_ke_length(const Config& config, const Model& model) {
-  if (is_arch(config.model.kind)) return config.model.radius;
+  if (is_arch_kind(config.model.kind)) return config.model.radius;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Block& b : model.blocks)
     if (!b.fixed)
@@ -123,7 +120,7 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
 
 void check_limit_admissibility(const Config& config, StabilityCell& cell) {
   try {
-    const Model model = build_model(config);
+    const Model model = build_model(scene_params(config));
     const LimitResult r = limit_analysis(model, config.contact.friction, config.load.gravity, true);
     cell.la_admissible = r.admissible;
     cell.la_status = r.status;

@@ -39,6 +39,8 @@
 #include <set>
 #include <sstream>
 
+#include "core/scene_kinds.hpp"
+
 namespace voussoir {
 
 bool ContactConfig::has(const std::string& key) const {
@@ -248,8 +250,7 @@ struct KeySpec {
   Apply apply;
 };
 
-const std::vector<std::string> kKinds = {"circular_arch", "basket_arch", "buttressed_arch",
-                                         "church",        "block",       "polygons"};
+const std::vector<std::string> kKinds = scene_kind_names();  // core/scene_kinds.hpp
 
 // Every key of the deck with its reader. Ranges are engineering limits: a value outside them
 // is a typing slip or a unit error (kPa for Pa, radians for degrees), never a real structure.
@@ -567,10 +568,11 @@ void check_together(const Reader& r, Config& c) {
   auto given = [&](const std::string& k) { return r.seen.count(k) != 0; };
   if (!given("model.kind"))
     throw DeckError(r.source + ": missing required key 'model.kind' (one of " + join(kKinds) + ")");
-  if (c.model.kind == "polygons" && !given("model.file"))
-    throw DeckError(r.where("model.kind", r.seen.at("model.kind")) +
-                    "missing required key 'model.file' (model.kind = \"polygons\" reads its blocks "
-                    "from a polygon text file or a gmsh .msh file)");
+  const SceneKind* kind = find_scene_kind(c.model.kind);  // known: read by r.choice(kKinds)
+  for (const RequiredKey& req : kind ? kind->required : std::vector<RequiredKey>{})
+    if (!given(req.key))
+      throw DeckError(r.where("model.kind", r.seen.at("model.kind")) + "missing required key '" +
+                      req.key + "' (model.kind = \"" + c.model.kind + "\" " + req.why + ")");
   if (c.load.base.signal == "file" && !given("load.base.file"))
     throw DeckError(r.where("load.base.signal", r.seen.at("load.base.signal")) +
                     "missing required key 'load.base.file' (load.base.signal = \"file\" reads a "

@@ -1,6 +1,7 @@
-// build_model: deck -> scene (mesh/scenes_*.cpp) -> meshed, finalized Model. Also the shared
-// helpers of the generators (element size, band cell choice, geometry errors) and the mesh
-// quality figure reported by `voussoir check`.
+// build_model: scene parameters -> scene (the generator of the kind, core/scene_kinds.hpp and
+// mesh/scenes_*.cpp) -> meshed, finalized Model. Also the shared helpers of the generators
+// (element size, band cell choice, geometry errors) and the mesh quality figure reported by
+// `voussoir check`.
 
 #include "mesh/scene.hpp"
 
@@ -12,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/scene_kinds.hpp"
 #include "core/schema.hpp"
 #include "mesh/scene_spec.hpp"
 
@@ -32,21 +34,21 @@ std::string format_number(double v) {
 
 }  // namespace
 
-[[noreturn]] void geometry_error(const Config& config, const std::string& key, double value,
+[[noreturn]] void geometry_error(const SceneParams& params, const std::string& key, double value,
                                  const std::string& why) {
-  geometry_error(config, key, format_number(value), why);
+  geometry_error(params, key, format_number(value), why);
 }
 
-[[noreturn]] void geometry_error(const Config& config, const std::string& key,
+[[noreturn]] void geometry_error(const SceneParams& params, const std::string& key,
                                  const std::string& value, const std::string& why) {
-  const std::string where = config.deck_path.empty() ? std::string() : config.deck_path + ": ";
+  const std::string where = params.deck_path.empty() ? std::string() : params.deck_path + ": ";
   throw DeckError(where + key + " = " + value + ": " + why);
 }
 
-double element_size(const Config& config, double reference) {
-  if (config.mesh.size > 0.0) return config.mesh.size;
-  const int n = config.mesh.through_thickness;
-  if (n < 1) geometry_error(config, "mesh.through_thickness", n, "expected an integer >= 1");
+double element_size(const SceneParams& params, double reference) {
+  if (params.mesh.size > 0.0) return params.mesh.size;
+  const int n = params.mesh.through_thickness;
+  if (n < 1) geometry_error(params, "mesh.through_thickness", n, "expected an integer >= 1");
   return reference / n;
 }
 
@@ -67,36 +69,43 @@ void choose_band_cells(double t, double length, double curvature_ratio, double h
   }
 }
 
-void check_triangle_budget(const Config& config, double estimate) {
+void check_triangle_budget(const SceneParams& params, double estimate) {
   if (estimate <= kMaxTriangles) return;
   std::ostringstream why;
   why << "would make about " << static_cast<long long>(estimate) << " triangles (limit "
       << static_cast<long long>(kMaxTriangles) << "); use a coarser mesh";
-  if (config.mesh.size > 0.0) geometry_error(config, "mesh.size", config.mesh.size, why.str());
-  geometry_error(config, "mesh.through_thickness", config.mesh.through_thickness, why.str());
+  if (params.mesh.size > 0.0) geometry_error(params, "mesh.size", params.mesh.size, why.str());
+  geometry_error(params, "mesh.through_thickness", params.mesh.through_thickness, why.str());
 }
 
-Scene build_scene(const Config& config) {
-  const std::string& kind = config.model.kind;
+Scene build_scene(const SceneParams& params) {
+  const std::string& kind = params.model.kind;
+  const SceneKind* entry = find_scene_kind(kind);
+  if (entry == nullptr) {
+    std::string names;
+    for (const std::string& n : scene_kind_names()) names += (names.empty() ? "" : ", ") + n;
+    geometry_error(params, "model.kind", "\"" + kind + "\"", "unknown scene (" + names + ")");
+  }
   Scene scene;
-  if (kind == "circular_arch" || kind == "basket_arch" || kind == "buttressed_arch") {
-    scene = build_arch_scene(config);
-  } else if (kind == "church") {
-    scene = build_church_scene(config);
-  } else if (kind == "block") {
-    scene = build_block_scene(config);
-  } else if (kind == "polygons") {
-    scene = build_polygons_scene(config);
-  } else {
-    geometry_error(config, "model.kind", "\"" + kind + "\"",
-                   "unknown scene (circular_arch, basket_arch, buttressed_arch, church, block, "
-                   "polygons)");
+  switch (entry->builder) {
+    case SceneBuilder::Arch:
+      scene = build_arch_scene(params);
+      break;
+    case SceneBuilder::Church:
+      scene = build_church_scene(params);
+      break;
+    case SceneBuilder::Block:
+      scene = build_block_scene(params);
+      break;
+    case SceneBuilder::Polygons:
+      scene = build_polygons_scene(params);
+      break;
   }
   scene.kind = kind;
   return scene;
 }
 
-Model mesh_scene(Scene& scene, const Config& config) {
+Model mesh_scene(Scene& scene, const SceneParams& params) {
   // Refuse meshes that would not fit in memory before building them.
   double estimate = 0.0;
   for (const BlockSpec& b : scene.blocks) {
@@ -107,7 +116,7 @@ Model mesh_scene(Scene& scene, const Config& config) {
       estimate += 2.0 * static_cast<double>(b.columns.size()) * b.columns[0].size();
     }
   }
-  check_triangle_budget(config, estimate);
+  check_triangle_budget(params, estimate);
 
   // Mesh every block that is not a mirror first, then the mirrors.
   for (BlockSpec& b : scene.blocks) {
@@ -163,7 +172,7 @@ Model mesh_scene(Scene& scene, const Config& config) {
           std::ostringstream why;
           why << "blocks " << i << " and " << j << " overlap (area " << area
               << " m2); blocks may touch but not overlap";
-          geometry_error(config, "model.file", "'" + config.model.file + "'", why.str());
+          geometry_error(params, "model.file", "'" + params.model.file + "'", why.str());
         }
       }
   }
@@ -173,32 +182,34 @@ Model mesh_scene(Scene& scene, const Config& config) {
   for (const BlockSpec& b : scene.blocks)
     add_block(model, boundary_loop(b.mesh), b.mesh.points, b.mesh.tris, b.fixed, b.role);
   model.joints = scene.joints;
-  model.material.density = config.material.density;
-  model.material.young = config.material.young;
-  model.material.poisson = config.material.poisson;
-  model.material.plane_stress = config.material.plane == "stress";
-  model.out_of_plane = config.model.out_of_plane;
+  model.material.density = params.material.density;
+  model.material.young = params.material.young;
+  model.material.poisson = params.material.poisson;
+  model.material.plane_stress = params.material.plane == "stress";
+  model.out_of_plane = params.model.out_of_plane;
   finalize_model(model);
   return model;
 }
 
-Model build_model(const Config& config) {
+Model build_model(const SceneParams& params) {
   // The checks of build_scene and the triangle budget catch the usual bad values; what still
   // fails inside the meshers (outlines that degenerate at extreme values, sizes whose boundary
   // subdivision overflows memory, found by tests/unit/test_fuzz.cpp) is a bad deck too, and
   // is reported as one (exit status 2), naming what went wrong.
-  const std::string where = config.deck_path.empty() ? std::string() : config.deck_path + ": ";
+  const std::string where = params.deck_path.empty() ? std::string() : params.deck_path + ": ";
   try {
-    Scene scene = build_scene(config);
-    return mesh_scene(scene, config);
+    Scene scene = build_scene(params);
+    return mesh_scene(scene, params);
   } catch (const DeckError&) {
     throw;
   } catch (const std::length_error&) {
-    throw DeckError(where + "the mesh of this model does not fit in memory: check the [model] "
-                            "dimensions against mesh.size / mesh.through_thickness");
+    throw DeckError(where +
+                    "the mesh of this model does not fit in memory: check the [model] "
+                    "dimensions against mesh.size / mesh.through_thickness");
   } catch (const std::bad_alloc&) {
-    throw DeckError(where + "the mesh of this model does not fit in memory: check the [model] "
-                            "dimensions against mesh.size / mesh.through_thickness");
+    throw DeckError(where +
+                    "the mesh of this model does not fit in memory: check the [model] "
+                    "dimensions against mesh.size / mesh.through_thickness");
   } catch (const std::exception& e) {
     throw DeckError(where + "the model cannot be meshed (" + e.what() +
                     "): check the [model] values (angles, dimensions) for degenerate blocks");

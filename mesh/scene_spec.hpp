@@ -1,12 +1,12 @@
 #pragma once
 // A scene before meshing: the blocks of a deck's [model] with their exact outlines, how each
 // is to be meshed, and the joints between them. `build_model` (mesh/scene.hpp) is
-// `mesh_scene(build_scene(config), config)`; tests use the two halves separately (exact
+// `mesh_scene(build_scene(params), params)`; tests use the two halves separately (exact
 // outline areas, centreline geometry).
 //
 // Conventions shared by every generator (SPEC.md section 3):
 //   - a key the deck did not give (ModelConfig::given) takes the default of the scene kind
-//     where SPEC gives one that differs from io/config.hpp's: the church's thickness is 0.5 m
+//     where SPEC gives one that differs from core/schema.hpp's: the church's thickness is 0.5 m
 //     and a block's height 1.0 m;
 //   - lengths in m, angles in the deck in degrees, here in radians unless the name says deg;
 //   - a scene that is mirror-symmetric has its axis at x = 0; the blocks of its left half are
@@ -84,11 +84,11 @@ struct Scene {
 
 // Builds the scene of the deck's [model] (not yet meshed). Throws DeckError for a geometry
 // the keys cannot make, naming the key, its value and what is wrong.
-Scene build_scene(const Config& config);
+Scene build_scene(const SceneParams& params);
 
 // Meshes every block of the scene, builds the Model (material, out_of_plane, joints) and
 // finalizes it. Fills BlockSpec::mesh of every block.
-Model mesh_scene(Scene& scene, const Config& config);
+Model mesh_scene(Scene& scene, const SceneParams& params);
 
 // Point of the centreline at arc length s from the left springing.
 Vec2 centreline_point(const Scene& scene, double s);
@@ -122,11 +122,11 @@ struct PointChain {
   }
 };
 
-// Generators, one per kind (mesh/scenes_*.cpp).
-Scene build_arch_scene(const Config& config);      // circular_arch, basket_arch, buttressed
-Scene build_church_scene(const Config& config);    // church
-Scene build_block_scene(const Config& config);     // block
-Scene build_polygons_scene(const Config& config);  // polygons
+// Generators (mesh/scenes_*.cpp), one per SceneBuilder of core/scene_kinds.hpp.
+Scene build_arch_scene(const SceneParams& params);      // circular_arch, basket_arch, buttressed
+Scene build_church_scene(const SceneParams& params);    // church
+Scene build_block_scene(const SceneParams& params);     // block
+Scene build_polygons_scene(const SceneParams& params);  // polygons
 
 // Element size h of the scene: mesh.size if given, else `reference / mesh.through_thickness`
 // (reference: the arch thickness; the block scene's min(width, height); the smallest free
@@ -135,17 +135,17 @@ Scene build_polygons_scene(const Config& config);  // polygons
 // bound of sqrt(2) h, the diagonal of such a cell, with their boundary cut every h; fixed
 // blocks are three times coarser inside (3 sqrt(2) h) but keep the nodes of the free blocks'
 // faces on theirs.
-double element_size(const Config& config, double reference);
+double element_size(const SceneParams& params, double reference);
 
 // Throws DeckError naming mesh.size (or mesh.through_thickness) when a mesh of about
 // `estimate` triangles would exceed the generators' limit (4e6). Generators call it before
 // allocating a structured mesh.
-void check_triangle_budget(const Config& config, double estimate);
+void check_triangle_budget(const SceneParams& params, double estimate);
 
 // Throws DeckError "<deck>: model.<key> = <value>: <why>".
-[[noreturn]] void geometry_error(const Config& config, const std::string& key, double value,
+[[noreturn]] void geometry_error(const SceneParams& params, const std::string& key, double value,
                                  const std::string& why);
-[[noreturn]] void geometry_error(const Config& config, const std::string& key,
+[[noreturn]] void geometry_error(const SceneParams& params, const std::string& key,
                                  const std::string& value, const std::string& why);
 
 // Chooses the cells of a voussoir-like band: n across the thickness t, m along the centreline

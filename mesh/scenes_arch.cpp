@@ -129,12 +129,12 @@ std::string fmt(double v) {
   return s.str();
 }
 
-HalfCentreline circular_centreline(const Config& config) {
-  const ModelConfig& mc = config.model;
+HalfCentreline circular_centreline(const SceneParams& params) {
+  const ModelConfig& mc = params.model;
   const double rc = mc.radius, t = mc.thickness, beta = mc.embrace * kDeg;
-  if (!(rc > 0.0)) geometry_error(config, "model.radius", rc, "expected a radius > 0 [m]");
+  if (!(rc > 0.0)) geometry_error(params, "model.radius", rc, "expected a radius > 0 [m]");
   if (!(t > 0.0 && t < 2.0 * rc))
-    geometry_error(config, "model.thickness", t,
+    geometry_error(params, "model.thickness", t,
                    "must be below twice the centreline radius (2 x model.radius = " +
                        fmt(2.0 * rc) + " m): the intrados radius Rc - t/2 must stay positive");
   HalfCentreline c;
@@ -144,24 +144,24 @@ HalfCentreline circular_centreline(const Config& config) {
   return c;
 }
 
-HalfCentreline basket_centreline(const Config& config) {
-  const ModelConfig& mc = config.model;
+HalfCentreline basket_centreline(const SceneParams& params) {
+  const ModelConfig& mc = params.model;
   const double rc = mc.radius, d = mc.offset, r = mc.small_radius, t = mc.thickness;
   const double g = 0.5 * (180.0 - mc.embrace) * kDeg;
-  if (!(rc > 0.0)) geometry_error(config, "model.radius", rc, "expected a radius > 0 [m]");
+  if (!(rc > 0.0)) geometry_error(params, "model.radius", rc, "expected a radius > 0 [m]");
   if (!(r > 0.0 && r < rc))
-    geometry_error(config, "model.small_radius", r,
+    geometry_error(params, "model.small_radius", r,
                    "the small arcs must lie inside the reference circle: need 0 < r < "
                    "model.radius = " +
                        fmt(rc) +
                        " m (their centres O3 = (Rc - r)(cos g, sin g) "
                        "must differ from O)");
   if (!(d > 0.0))
-    geometry_error(config, "model.offset", d,
+    geometry_error(params, "model.offset", d,
                    "the large arc's centre O1 = (0, -d) must lie below O (d > 0); with d <= 0 "
                    "the large arc cannot be tangent to both small arcs from above");
   if (!(t > 0.0 && t < 2.0 * r))
-    geometry_error(config, "model.thickness", t,
+    geometry_error(params, "model.thickness", t,
                    "must be below twice model.small_radius (2 r = " + fmt(2.0 * r) +
                        " m): the intrados of the small arcs, radius r - t/2, must stay positive");
   const Vec2 o3{(rc - r) * std::cos(g), (rc - r) * std::sin(g)};
@@ -170,9 +170,9 @@ HalfCentreline basket_centreline(const Config& config) {
   const double psi = std::atan2(o3.y - o1.y, o3.x - o1.x);
   // psi > g holds for d > 0 and psi < 90 deg for r < Rc; checked all the same.
   if (!(psi > g && psi < 0.5 * kPi))
-    geometry_error(config, "model.offset", d, "the small and large arcs cannot be made tangent");
+    geometry_error(params, "model.offset", d, "the small and large arcs cannot be made tangent");
   if (!(t < 2.0 * r1))
-    geometry_error(config, "model.thickness", t, "thicker than the large arc allows");
+    geometry_error(params, "model.thickness", t, "thicker than the large arc allows");
   HalfCentreline c;
   c.pieces.push_back(Piece{o1, r1, 0.5 * kPi, r1 * (0.5 * kPi - psi)});
   c.pieces.push_back(Piece{o3, r, psi, r * (psi - g)});
@@ -184,11 +184,11 @@ HalfCentreline basket_centreline(const Config& config) {
 // Voussoirs of a symmetric arch: adds N band blocks (indices 0..N-1 if the scene is empty) and
 // their mutual joints; returns the springing faces (intrados to extrados) through `left` and
 // `right`.
-void add_voussoirs(const Config& config, const HalfCentreline& cl, Scene& scene,
+void add_voussoirs(const SceneParams& params, const HalfCentreline& cl, Scene& scene,
                    std::vector<Vec2>* left, std::vector<Vec2>* right) {
-  const ModelConfig& mc = config.model;
+  const ModelConfig& mc = params.model;
   const int nv = mc.voussoirs;
-  if (nv < 1) geometry_error(config, "model.voussoirs", nv, "an arch needs at least 1 voussoir");
+  if (nv < 1) geometry_error(params, "model.voussoirs", nv, "an arch needs at least 1 voussoir");
   const double t = mc.thickness, beta_deg = mc.embrace;
   // A voussoir much thinner along the arch than across it is a slice, not a block: its
   // meshing needs slivers or tens of thousands of cells and a time step of ~1e-10 s (found by
@@ -200,13 +200,13 @@ void add_voussoirs(const Config& config, const HalfCentreline& cl, Scene& scene,
     why << "gives voussoirs " << voussoir_length << " m long for a thickness of " << t
         << " m (more than " << kMaxSlenderness << " times thinner than thick): use fewer "
         << "voussoirs or a larger embrace or radius";
-    geometry_error(config, "model.embrace", beta_deg, why.str());
+    geometry_error(params, "model.embrace", beta_deg, why.str());
   }
-  const double h = element_size(config, t);
+  const double h = element_size(params, t);
   int n = 1, m = 1;
   choose_band_cells(t, 2.0 * cl.half_length / nv, 0.5 * t / cl.min_radius, h, &n, &m);
 
-  check_triangle_budget(config, 2.0 * nv * (static_cast<double>(n) * m + n));
+  check_triangle_budget(params, 2.0 * nv * (static_cast<double>(n) * m + n));
   const long long nm = static_cast<long long>(nv) * m;
   const double du = cl.half_length / static_cast<double>(nm);
   const double dw = t / (2.0 * n);
@@ -277,9 +277,9 @@ void add_voussoirs(const Config& config, const HalfCentreline& cl, Scene& scene,
 }
 
 // Fixed abutments whose top faces are the springing joints.
-void add_abutments(const Config& config, Scene& scene, const std::vector<Vec2>& left,
+void add_abutments(const SceneParams& params, Scene& scene, const std::vector<Vec2>& left,
                    const std::vector<Vec2>& right) {
-  const double t = config.model.thickness, h = scene.element_size;
+  const double t = params.model.thickness, h = scene.element_size;
   const Index nv = static_cast<Index>(scene.blocks.size());
   const std::size_t n = right.size() - 1;
   const Vec2 ip = right.front(), ep = right.back();
@@ -289,7 +289,7 @@ void add_abutments(const Config& config, Scene& scene, const std::vector<Vec2>& 
   const Vec2 down{f.y, -f.x};
   const Vec2 ib = ip + t * down, eb = ep + t * down;
   if (!(std::min(ib.x, eb.x) > 0.0))
-    geometry_error(config, "model.embrace", config.model.embrace,
+    geometry_error(params, "model.embrace", params.model.embrace,
                    "the springings are too close together for their abutments (the arch closes "
                    "on itself); use a smaller embrace");
 
@@ -315,26 +315,26 @@ void add_abutments(const Config& config, Scene& scene, const std::vector<Vec2>& 
   scene.blocks.push_back(std::move(l));
   scene.blocks.push_back(std::move(r));
   scene.joints.insert(scene.joints.begin(), Joint{nv, 0, left.front(), left.back(), 0.0});
-  scene.joints.push_back(Joint{nv - 1, nv + 1, ip, ep, config.model.embrace});
+  scene.joints.push_back(Joint{nv - 1, nv + 1, ip, ep, params.model.embrace});
 }
 
 // Buttresses (free, monolithic or coursed) and the fixed ground under them.
-void add_buttresses(const Config& config, Scene& scene, const std::vector<Vec2>& left,
+void add_buttresses(const SceneParams& params, Scene& scene, const std::vector<Vec2>& left,
                     const std::vector<Vec2>& right) {
-  const ModelConfig& mc = config.model;
+  const ModelConfig& mc = params.model;
   const double h = scene.element_size;
   const double bw = mc.buttress_width, h1 = mc.base_depth, hc = mc.courses;
   const Index nv = static_cast<Index>(scene.blocks.size());
   const Vec2 ip = right.front(), ep = right.back();
   const double joint_dx = ep.x - ip.x;
   if (!(bw > joint_dx * (1.0 + 1e-9)))
-    geometry_error(config, "model.buttress_width", bw,
+    geometry_error(params, "model.buttress_width", bw,
                    "the buttress must reach past the extrados springing: B must exceed the "
                    "springing joint's horizontal extent " +
                        fmt(joint_dx) + " m");
   const double y_low = std::min(ip.y, ep.y);
   if (!(-h1 < y_low - 1e-9 * mc.thickness))
-    geometry_error(config, "model.base_depth", h1,
+    geometry_error(params, "model.base_depth", h1,
                    "the ground line y = -H1 must lie below the springing (lowest springing "
                    "point at y = " +
                        fmt(y_low) + " m)");
@@ -345,7 +345,7 @@ void add_buttresses(const Config& config, Scene& scene, const std::vector<Vec2>&
   if (hc > 0.0) {
     const double top = y_low - 1e-9 * hc;
     if ((top - yg) / hc > 10000.0)
-      geometry_error(config, "model.courses", hc, "makes more than 10000 courses per buttress");
+      geometry_error(params, "model.courses", hc, "makes more than 10000 courses per buttress");
     for (int k = 1;; ++k) {
       const double y = yg + k * hc;
       if (!(y < top)) break;
@@ -430,29 +430,29 @@ void add_buttresses(const Config& config, Scene& scene, const std::vector<Vec2>&
 
 }  // namespace
 
-Scene build_arch_scene(const Config& config) {
-  const ModelConfig& mc = config.model;
+Scene build_arch_scene(const SceneParams& params) {
+  const ModelConfig& mc = params.model;
   std::string shape;
   if (mc.kind == "circular_arch") shape = "circular";
   if (mc.kind == "basket_arch") shape = "basket";
   if (mc.kind == "buttressed_arch") {
     shape = mc.shape;
     if (shape != "circular" && shape != "basket")
-      geometry_error(config, "model.shape", "\"" + shape + "\"",
+      geometry_error(params, "model.shape", "\"" + shape + "\"",
                      "expected \"circular\" or \"basket\"");
   }
   if (!(mc.embrace > 0.0 && mc.embrace < 360.0))
-    geometry_error(config, "model.embrace", mc.embrace, "expected an angle in (0, 360) degrees");
+    geometry_error(params, "model.embrace", mc.embrace, "expected an angle in (0, 360) degrees");
   const HalfCentreline cl =
-      shape == "circular" ? circular_centreline(config) : basket_centreline(config);
+      shape == "circular" ? circular_centreline(params) : basket_centreline(params);
 
   Scene scene;
   std::vector<Vec2> left, right;
-  add_voussoirs(config, cl, scene, &left, &right);
+  add_voussoirs(params, cl, scene, &left, &right);
   if (mc.kind == "buttressed_arch")
-    add_buttresses(config, scene, left, right);
+    add_buttresses(params, scene, left, right);
   else
-    add_abutments(config, scene, left, right);
+    add_abutments(params, scene, left, right);
   return scene;
 }
 

@@ -32,22 +32,22 @@ Vec2 rotate(Vec2 p, double c, double s) {
 
 }  // namespace
 
-Scene build_block_scene(const Config& config) {
-  const ModelConfig& mc = config.model;
-  // SPEC gives no block height; io/config's 5.0 is the church's. A block deck without
+Scene build_block_scene(const SceneParams& params) {
+  const ModelConfig& mc = params.model;
+  // SPEC gives no block height; core/schema.hpp's 5.0 is the church's. A block deck without
   // `height` gets a 1.0 m block.
   const double w = mc.width, ht = mc.has("height") ? mc.height : 1.0, incline = mc.incline;
   const int stack = mc.stack;
-  if (!(w > 0.0)) geometry_error(config, "model.width", w, "expected a width > 0 m");
-  if (!(ht > 0.0)) geometry_error(config, "model.height", ht, "expected a height > 0 m");
-  if (stack < 1) geometry_error(config, "model.stack", stack, "expected at least 1 block");
+  if (!(w > 0.0)) geometry_error(params, "model.width", w, "expected a width > 0 m");
+  if (!(ht > 0.0)) geometry_error(params, "model.height", ht, "expected a height > 0 m");
+  if (stack < 1) geometry_error(params, "model.stack", stack, "expected at least 1 block");
   if (!(incline >= 0.0 && incline < 90.0))
-    geometry_error(config, "model.incline", incline, "expected an angle in [0, 90) degrees");
+    geometry_error(params, "model.incline", incline, "expected an angle in [0, 90) degrees");
 
-  const double h = element_size(config, std::min(w, ht));
+  const double h = element_size(params, std::min(w, ht));
   int n = 1, m = 1;  // n rows up the height, m columns across the width
   choose_band_cells(ht, w, 0.0, h, &n, &m);
-  check_triangle_budget(config, 2.0 * stack * (static_cast<double>(n) * m + n));
+  check_triangle_budget(params, 2.0 * stack * (static_cast<double>(n) * m + n));
 
   Scene scene;
   scene.element_size = h;

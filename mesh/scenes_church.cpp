@@ -110,37 +110,37 @@ struct SpanFaces {
 
 }  // namespace
 
-Scene build_church_scene(const Config& config) {
-  const ModelConfig& mc = config.model;
+Scene build_church_scene(const SceneParams& params) {
+  const ModelConfig& mc = params.model;
   const std::vector<double>& spans = mc.spans;
   const int ns = static_cast<int>(spans.size());
   const double pier = mc.pier_width, outer = mc.outer_width, height = mc.height;
-  // SPEC's church thickness default (0.5 m) differs from the arches' (io/config: 0.2 m).
+  // SPEC's church thickness default (0.5 m) differs from the arches' (core/schema.hpp: 0.2 m).
   const double t = mc.has("thickness") ? mc.thickness : 0.5, ecc = mc.eccentricity,
                dtheta = mc.voussoir_angle * kDeg;
   const double hc = mc.courses;
-  if (ns < 1) geometry_error(config, "model.spans", "[]", "expected at least one span");
+  if (ns < 1) geometry_error(params, "model.spans", "[]", "expected at least one span");
   for (double s : spans)
-    if (!(s > 0.0)) geometry_error(config, "model.spans", s, "every span must be > 0 m");
-  if (!(t > 0.0)) geometry_error(config, "model.thickness", t, "expected a thickness > 0 m");
+    if (!(s > 0.0)) geometry_error(params, "model.spans", s, "every span must be > 0 m");
+  if (!(t > 0.0)) geometry_error(params, "model.thickness", t, "expected a thickness > 0 m");
   // A support exactly as wide as its springings (pier = 2t, outer = t, the default church)
   // is allowed: the extrados springing points then meet at the pier's middle (or the outer
   // face) and are made the same point.
   constexpr double kTight = 1e-9;
   if (!(outer >= t * (1.0 - kTight)))
-    geometry_error(config, "model.outer_width", outer,
+    geometry_error(params, "model.outer_width", outer,
                    "an outer buttress must carry its arch's springing joint: it must be at least "
                    "model.thickness = " +
                        fmt(t) + " m wide");
   if (ns > 1 && !(pier >= 2.0 * t * (1.0 - kTight)))
-    geometry_error(config, "model.pier_width", pier,
+    geometry_error(params, "model.pier_width", pier,
                    "too narrow for its two springings: a pier carries two springing joints of "
                    "model.thickness = " +
                        fmt(t) + " m each, so it must be at least " + fmt(2.0 * t) + " m wide");
-  if (!(height > 0.0)) geometry_error(config, "model.height", height, "expected a height > 0 m");
-  if (!(ecc >= 0.0)) geometry_error(config, "model.eccentricity", ecc, "expected a value >= 0");
+  if (!(height > 0.0)) geometry_error(params, "model.height", height, "expected a height > 0 m");
+  if (!(ecc >= 0.0)) geometry_error(params, "model.eccentricity", ecc, "expected a value >= 0");
   if (!(dtheta > 0.0 && dtheta < 0.5 * kPi))
-    geometry_error(config, "model.voussoir_angle", mc.voussoir_angle, "expected (0, 90) degrees");
+    geometry_error(params, "model.voussoir_angle", mc.voussoir_angle, "expected (0, 90) degrees");
   // Absurd sizes. Supports are outlined at the arches' element size before any triangle
   // budget can be estimated (mesh/scene.cpp), so a 4.3e9 m outer buttress (fuzzing, issue 8)
   // exhausted memory in the generator. No church has a support or a height of more than
@@ -149,7 +149,7 @@ Scene build_church_scene(const Config& config) {
   const double size_limit = kMaxSizeToSpan * span_max;
   auto refuse_above_limit = [&](const char* key, double value) {
     if (!(value <= size_limit))
-      geometry_error(config, key, value,
+      geometry_error(params, key, value,
                      "expected at most " + fmt(kMaxSizeToSpan) + " x the largest span (" +
                          fmt(span_max) + " m), i.e. " + fmt(size_limit) + " m");
   };
@@ -157,14 +157,14 @@ Scene build_church_scene(const Config& config) {
   if (ns > 1) refuse_above_limit("model.pier_width", pier);
   refuse_above_limit("model.height", height);
   if (!(height >= kMinHeightToSpan * span_max))
-    geometry_error(config, "model.height", height,
+    geometry_error(params, "model.height", height,
                    "expected at least " + fmt(kMinHeightToSpan) + " x the largest span (" +
                        fmt(span_max) + " m), i.e. " + fmt(kMinHeightToSpan * span_max) + " m");
   refuse_above_limit("model.thickness", t);
   if (hc > 0.0 && height / hc > 10000.0)
-    geometry_error(config, "model.courses", hc, "makes more than 10000 courses per support");
+    geometry_error(params, "model.courses", hc, "makes more than 10000 courses per support");
 
-  const double h = element_size(config, t);
+  const double h = element_size(params, t);
   bool symmetric = true;
   for (int i = 0; i < ns; ++i) symmetric = symmetric && spans[i] == spans[ns - 1 - i];
 
@@ -221,11 +221,11 @@ Scene build_church_scene(const Config& config) {
     if (th_i - kh * dtheta < 0.5 * dtheta) --kh;
     kh = std::max(kh, 0);
     if (kh > 100000)
-      geometry_error(config, "model.voussoir_angle", mc.voussoir_angle,
+      geometry_error(params, "model.voussoir_angle", mc.voussoir_angle,
                      "makes more than 100000 voussoirs per half arch");
     int n = 1, m = 1;
     choose_band_cells(t, (ri + 0.5 * t) * dtheta, 0.5 * t / (ri + 0.5 * t), h, &n, &m);
-    check_triangle_budget(config, 4.0 * kh * (static_cast<double>(n) * m + n));
+    check_triangle_budget(params, 4.0 * kh * (static_cast<double>(n) * m + n));
     const double ya_i = height + std::sqrt(ri * ri - c * c);
     const double ya_e = height + std::sqrt(re * re - c * c);
     const Vec2 apex_i{xm, ya_i}, apex_e{xm, ya_e};

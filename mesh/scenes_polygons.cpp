@@ -316,15 +316,15 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
-Scene build_polygons_scene(const Config& config) {
-  const ModelConfig& mc = config.model;
+Scene build_polygons_scene(const SceneParams& params) {
+  const ModelConfig& mc = params.model;
   namespace fs = std::filesystem;
   if (mc.file.empty())
-    geometry_error(config, "model.file", "\"\"",
+    geometry_error(params, "model.file", "\"\"",
                    "model.kind = \"polygons\" needs a file of blocks");
   fs::path path(mc.file);
-  if (path.is_relative() && !fs::exists(path) && !config.deck_dir.empty())
-    path = fs::path(config.deck_dir) / path;
+  if (path.is_relative() && !fs::exists(path) && !params.deck_dir.empty())
+    path = fs::path(params.deck_dir) / path;
   const std::string shown = "'" + mc.file + "'";
 
   Scene scene;
@@ -361,13 +361,13 @@ Scene build_polygons_scene(const Config& config) {
       }
     }
   } catch (const FileError& e) {
-    geometry_error(config, "model.file", shown, e.what);
+    geometry_error(params, "model.file", shown, e.what);
   }
 
   const std::size_t nb = scene.blocks.size();
   for (int f : mc.fixed)
     if (f < 0 || static_cast<std::size_t>(f) >= nb)
-      geometry_error(config, "model.fixed", f,
+      geometry_error(params, "model.fixed", f,
                      "no such block: the file has " + std::to_string(nb) + " blocks (indices 0.." +
                          std::to_string(nb - 1) + ")");
   for (std::size_t b = 0; b < nb; ++b) {
@@ -392,7 +392,7 @@ Scene build_polygons_scene(const Config& config) {
     }
     reference = std::min({reference, x1 - x0, y1 - y0});
   }
-  const double h = element_size(config, reference);
+  const double h = element_size(params, reference);
   scene.element_size = h;
   // Refuse too fine a mesh before outlining: every edge is cut at the element size below, so a
   // mistyped coordinate (2147483648 for 2, fuzzing of issue 8) made billions of boundary points
@@ -407,7 +407,7 @@ Scene build_polygons_scene(const Config& config) {
     for (std::size_t e = 0; e < p.size(); ++e) perimeter += norm(p[(e + 1) % p.size()] - p[e]);
     estimate += perimeter / h + 5.0 * std::abs(polygon_area(p)) / (size * size);
   }
-  check_triangle_budget(config, estimate);
+  check_triangle_budget(params, estimate);
   // Conforming faces: a vertex of another block lying on an edge (a T-junction, e.g. a block
   // standing on a longer ground edge) is inserted into that edge, so both blocks get a node
   // there; then every edge is cut from its lexicographically smaller end so that a face shared

@@ -17,29 +17,13 @@
 #include "core/step.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
+#include "mesh/rectangle.hpp"
 
 using namespace voussoir;
 
 namespace {
 
 constexpr double kG = 9.81;
-
-// Rectangle [x0, x0 + w] x [y0, y0 + h] meshed as nx x ny quads, two triangles each.
-void add_rectangle(Model& m, double x0, double y0, double w, double h, int nx, int ny, bool fixed,
-                   const std::string& role) {
-  std::vector<Vec2> pts;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) pts.push_back({x0 + w * i / nx, y0 + h * j / ny});
-  std::vector<std::array<Index, 3>> tris;
-  auto id = [nx](int i, int j) { return static_cast<Index>(j * (nx + 1) + i); };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  const std::vector<Vec2> outline = {{x0, y0}, {x0 + w, y0}, {x0 + w, y0 + h}, {x0, y0 + h}};
-  add_block(m, outline, pts, tris, fixed, role);
-}
 
 // Rotates every node (reference and current) and outline by angle [rad] about the origin.
 void rotate_model(Model& m, double angle) {
@@ -61,9 +45,11 @@ void rotate_model(Model& m, double angle) {
 Model block_scene(double w, double h, int stack, int nx, int ny, double ground_width = 4.0,
                   double gap = 0.0) {
   Model m;
-  add_rectangle(m, -0.5 * ground_width, -0.5, ground_width, 0.5, 8, 1, true, "ground");
+  add_grid_rectangle(m, -0.5 * ground_width, -0.5, ground_width, 0.5, 8, 1, true, "ground",
+                     GridDiagonals::Uniform);
   for (int k = 0; k < stack; ++k)
-    add_rectangle(m, -0.5 * w, gap + k * h, w, h, nx, ny, false, "block");
+    add_grid_rectangle(m, -0.5 * w, gap + k * h, w, h, nx, ny, false, "block",
+                       GridDiagonals::Uniform);
   return m;
 }
 
@@ -309,8 +295,8 @@ TEST(ContactBlocks, OmegaEstimateBoundsTrueContactFrequency) {
     if (scene == 1) m = block_scene(0.5, 0.4, 2, 3, 2);
     if (scene == 2) {
       m = block_scene(0.4, 0.5, 0, 1, 1);
-      add_rectangle(m, -0.4, 0.0, 0.4, 0.5, 2, 2, false, "block");
-      add_rectangle(m, 0.0, 0.0, 0.3, 0.5, 3, 4, false, "block");
+      add_grid_rectangle(m, -0.4, 0.0, 0.4, 0.5, 2, 2, false, "block", GridDiagonals::Uniform);
+      add_grid_rectangle(m, 0.0, 0.0, 0.3, 0.5, 3, 4, false, "block", GridDiagonals::Uniform);
     }
     Simulation sim = make_sim(std::move(m), 0.6, 1.0);
     // Press the blocks into their neighbours by 1e-4 m (the stiffness of a flat overlap does
@@ -418,11 +404,11 @@ TEST(ContactBlocks, ShippedBlockSceneOnIncline) {
 // energies and dissipation on 1 and on 3 threads.
 TEST(ContactBlocks, ThreadCountDoesNotChangeResults) {
   Model base;
-  add_rectangle(base, -0.1, -0.1, 1.5, 0.1, 12, 1, true, "ground");
+  add_grid_rectangle(base, -0.1, -0.1, 1.5, 0.1, 12, 1, true, "ground", GridDiagonals::Uniform);
   for (int j = 0; j < 12; ++j)
     for (int i = 0; i < 12; ++i)
-      add_rectangle(base, i * (0.1 - 1e-5), j * (0.1 - 1e-5) - 1e-5, 0.1, 0.1, 1, 1, false,
-                    "block");
+      add_grid_rectangle(base, i * (0.1 - 1e-5), j * (0.1 - 1e-5) - 1e-5, 0.1, 0.1, 1, 1, false,
+                         "block", GridDiagonals::Uniform);
   base.material.young = 40e9;
   finalize_model(base);
   auto run = [&](int threads, std::vector<double>& out) {

@@ -14,35 +14,19 @@
 
 #include "core/cst.hpp"
 #include "core/model.hpp"
+#include "mesh/rectangle.hpp"
 
 namespace voussoir {
 namespace {
 
 // A width x height rectangle with its lower-left corner at (x0, y0), nx x ny cells, each cell
 // split into two triangles with the diagonal direction alternating (a criss-cross of
-// different triangle shapes), finalized as a one-block model.
+// different triangle shapes: mesh/rectangle.hpp), finalized as a one-block model.
 Model make_rectangle(double width, double height, int nx, int ny, const Material& mat,
                      double x0 = 0.0, double y0 = 0.0) {
   Model model;
   model.material = mat;
-  std::vector<Vec2> points;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) points.push_back({x0 + width * i / nx, y0 + height * j / ny});
-  auto id = [nx](int i, int j) { return Index(j * (nx + 1) + i); };
-  std::vector<std::array<Index, 3>> tris;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      if ((i + j) % 2 == 0) {
-        tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      } else {
-        tris.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
-        tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-    }
-  const std::vector<Vec2> outline = {
-      {x0, y0}, {x0 + width, y0}, {x0 + width, y0 + height}, {x0, y0 + height}};
-  add_block(model, outline, points, tris, false, "test");
+  add_grid_rectangle(model, x0, y0, width, height, nx, ny, false, "test");
   finalize_model(model);
   return model;
 }

@@ -15,33 +15,10 @@
 #include "core/cst.hpp"
 #include "core/model.hpp"
 #include "core/step.hpp"
+#include "mesh/rectangle.hpp"
 
 namespace voussoir {
 namespace {
-
-// A width x height rectangle at (x0, y0), nx x ny cells split into triangles with alternating
-// diagonals, appended to `model` as one block.
-void add_rectangle(Model& model, double width, double height, int nx, int ny, bool fixed,
-                   double x0 = 0.0, double y0 = 0.0) {
-  std::vector<Vec2> points;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) points.push_back({x0 + width * i / nx, y0 + height * j / ny});
-  auto id = [nx](int i, int j) { return Index(j * (nx + 1) + i); };
-  std::vector<std::array<Index, 3>> tris;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      if ((i + j) % 2 == 0) {
-        tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      } else {
-        tris.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
-        tris.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-    }
-  const std::vector<Vec2> outline = {
-      {x0, y0}, {x0 + width, y0}, {x0 + width, y0 + height}, {x0, y0 + height}};
-  add_block(model, outline, points, tris, fixed, fixed ? "ground" : "test");
-}
 
 Material stone() {
   Material m;
@@ -56,7 +33,7 @@ Simulation make_block_sim(const Material& mat, double width, double height, int 
                           double damping_factor) {
   Simulation sim;
   sim.model.material = mat;
-  add_rectangle(sim.model, width, height, nx, ny, false);
+  add_grid_rectangle(sim.model, 0.0, 0.0, width, height, nx, ny, false, "test");
   finalize_model(sim.model);
   sim.ctx.contact_on = false;
   sim.ctx.body_ax = 0.0;
@@ -361,8 +338,8 @@ TEST(Dynamics, FixedBlocksNeverMoveAndGetNoElementWork) {
   const Material mat = stone();
   Simulation sim;
   sim.model.material = mat;
-  add_rectangle(sim.model, 1.0, 0.2, 4, 1, true, -0.3, -0.2);
-  add_rectangle(sim.model, 0.4, 0.2, 4, 2, false, 0.0, 0.1);
+  add_grid_rectangle(sim.model, -0.3, -0.2, 1.0, 0.2, 4, 1, true, "ground");
+  add_grid_rectangle(sim.model, 0.0, 0.1, 0.4, 0.2, 4, 2, false, "test");
   finalize_model(sim.model);
   sim.ctx.contact_on = false;
   sim.ctx.body_ax = 3.0;

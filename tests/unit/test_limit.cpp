@@ -22,6 +22,7 @@
 #include "limit/interfaces.hpp"
 #include "limit/limit_analysis.hpp"
 #include "mesh/geometry.hpp"
+#include "mesh/rectangle.hpp"
 #include "mesh/scene.hpp"
 
 namespace voussoir {
@@ -32,29 +33,15 @@ std::string case_path(const std::string& name) {
 }
 
 Model case_model(const std::string& name, const std::vector<std::string>& sets = {}) {
-  return build_model(load_deck(case_path(name), sets));
+  return build_model(scene_params(load_deck(case_path(name), sets)));
 }
 
 // A width x height rectangle at (x0, y0) as one block, its sides cut into nx and ny pieces
-// (so its outline has collinear vertices, like a meshed block).
-Index add_rectangle(Model& model, double x0, double y0, double width, double height, int nx, int ny,
-                    bool fixed) {
-  std::vector<Vec2> points;
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) points.push_back({x0 + width * i / nx, y0 + height * j / ny});
-  auto id = [nx](int i, int j) { return Index(j * (nx + 1) + i); };
-  std::vector<std::array<Index, 3>> tris;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  std::vector<Vec2> outline;
-  for (int i = 0; i < nx; ++i) outline.push_back(points[id(i, 0)]);
-  for (int j = 0; j < ny; ++j) outline.push_back(points[id(nx, j)]);
-  for (int i = nx; i > 0; --i) outline.push_back(points[id(i, ny)]);
-  for (int j = ny; j > 0; --j) outline.push_back(points[id(0, j)]);
-  return add_block(model, outline, points, tris, fixed, fixed ? "ground" : "block");
+// (so its outline has collinear vertices, like a meshed block): mesh/rectangle.hpp.
+Index add_cut_rectangle(Model& model, double x0, double y0, double width, double height, int nx,
+                        int ny, bool fixed) {
+  return add_grid_rectangle(model, x0, y0, width, height, nx, ny, fixed, fixed ? "ground" : "block",
+                            GridDiagonals::Uniform, GridOutline::Nodes);
 }
 
 // Residual of every free block's equilibrium (force x, force y, moment about its centroid)
@@ -138,10 +125,11 @@ TEST(LimitInterfaces, PolygonCentroidOfAnLShape) {
 
 TEST(LimitInterfaces, MergesCollinearEdgesIntoOneInterfacePerFace) {
   Model m;
-  add_rectangle(m, 0.0, 0.0, 1.0, 1.0, 3, 2, false);   // block 0, edges cut in pieces
-  add_rectangle(m, 1.0, 0.25, 1.0, 0.5, 1, 5, false);  // block 1: touches 0 on x = 1, y 0.25..0.75
-  add_rectangle(m, 2.0, 0.75, 1.0, 1.0, 2, 2, false);  // block 2: touches 1 at one corner only
-  add_rectangle(m, -1.0, -0.5, 4.0, 0.5, 7, 1, true);  // block 3: ground under block 0
+  add_cut_rectangle(m, 0.0, 0.0, 1.0, 1.0, 3, 2, false);  // block 0, edges cut in pieces
+  add_cut_rectangle(m, 1.0, 0.25, 1.0, 0.5, 1, 5,
+                    false);  // block 1: touches 0 on x = 1, y 0.25..0.75
+  add_cut_rectangle(m, 2.0, 0.75, 1.0, 1.0, 2, 2, false);  // block 2: touches 1 at one corner only
+  add_cut_rectangle(m, -1.0, -0.5, 4.0, 0.5, 7, 1, true);  // block 3: ground under block 0
   finalize_model(m);
   const auto faces = find_interfaces(m);
   ASSERT_EQ(faces.size(), 2u);
@@ -232,8 +220,8 @@ TEST(LimitBlock, GravityOnlyOnAnInclineSticksIffTanBelowMu) {
 
 TEST(LimitBlock, FloatingBlockHasNoEquilibrium) {
   Model m;
-  add_rectangle(m, 0.0, 0.0, 1.0, 1.0, 1, 1, true);
-  add_rectangle(m, 0.0, 1.5, 1.0, 1.0, 1, 1, false);  // not touching the ground
+  add_cut_rectangle(m, 0.0, 0.0, 1.0, 1.0, 1, 1, true);
+  add_cut_rectangle(m, 0.0, 1.5, 1.0, 1.0, 1, 1, false);  // not touching the ground
   finalize_model(m);
   EXPECT_EQ(limit_analysis(m, 0.6, 9.81, false).status, "infeasible");
   EXPECT_FALSE(limit_analysis(m, 0.6, 9.81, true).admissible);
@@ -242,10 +230,10 @@ TEST(LimitBlock, FloatingBlockHasNoEquilibrium) {
 TEST(LimitBlock, WedgedBlockNeverCollapses) {
   // A block between two fixed walls on a fixed ground: every horizontal load is carried.
   Model m;
-  add_rectangle(m, -1.0, -0.5, 3.0, 0.5, 3, 1, true);  // ground
-  add_rectangle(m, -1.0, 0.0, 1.0, 1.0, 1, 1, true);   // left wall
-  add_rectangle(m, 1.0, 0.0, 1.0, 1.0, 1, 1, true);    // right wall
-  add_rectangle(m, 0.0, 0.0, 1.0, 1.0, 2, 2, false);   // the block, touching all three
+  add_cut_rectangle(m, -1.0, -0.5, 3.0, 0.5, 3, 1, true);  // ground
+  add_cut_rectangle(m, -1.0, 0.0, 1.0, 1.0, 1, 1, true);   // left wall
+  add_cut_rectangle(m, 1.0, 0.0, 1.0, 1.0, 1, 1, true);    // right wall
+  add_cut_rectangle(m, 0.0, 0.0, 1.0, 1.0, 2, 2, false);   // the block, touching all three
   finalize_model(m);
   EXPECT_EQ(find_interfaces(m).size(), 5u);  // 2 ground-wall, 3 around the block
   const LimitResult r = limit_analysis(m, 0.6, 9.81, false);

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "drivers/pulse.hpp"
+#include "io/accelerogram.hpp"
 #include "io/deck.hpp"
 #include "mesh/scene.hpp"
 
@@ -84,7 +85,7 @@ TEST(PulseBlock, BaseStepBelowThresholdDoesNotRockAboveOverturns) {
 TEST(PulseControlPoints, ScaledArchSixthVoussoirExtrados) {
   const Config config = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/scaled_arch.toml",
                                   {"mesh.through_thickness=1"});
-  const Model model = build_model(config);
+  const Model model = build_model(scene_params(config));
   const std::vector<ControlPoint> points = find_control_points(model);
   ASSERT_EQ(points.size(), 4u);
   EXPECT_EQ(points[0].name, "left6_springing_side");

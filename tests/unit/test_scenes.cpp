@@ -14,7 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "core/scene_kinds.hpp"
 #include "io/deck.hpp"
+#include "mesh/rectangle.hpp"
 #include "mesh/scene.hpp"
 #include "mesh/scene_spec.hpp"
 
@@ -24,8 +26,9 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 
-Config make_deck(const std::string& text) {
-  return parse_deck(text, "test.toml", {}, VOUSSOIR_SOURCE_DIR "/tests/data");
+// The scene parameters of a deck text (mesh/ reads only these).
+SceneParams make_deck(const std::string& text) {
+  return scene_params(parse_deck(text, "test.toml", {}, VOUSSOIR_SOURCE_DIR "/tests/data"));
 }
 
 std::string arch_deck(const std::string& kind, double embrace, int through = 2) {
@@ -145,7 +148,7 @@ TEST(Scenes, ArchExactAreaEqualsCentrelineLengthTimesThickness) {
   // The exact block outlines (arcs included) of the free blocks enclose L x t to 1e-9.
   for (const std::string kind : {"circular_arch", "basket_arch"})
     for (double beta : {120.0, 150.0, 180.0}) {
-      const Config c = make_deck(arch_deck(kind, beta));
+      const SceneParams c = make_deck(arch_deck(kind, beta));
       const Scene s = build_scene(c);
       const double length =
           analytic_length(kind == "circular_arch" ? "circular" : "basket", 1.0, 0.5, 0.5, beta);
@@ -172,7 +175,7 @@ TEST(Scenes, CircularArchMeshedAreaIsTheChordPolygonAndConverges) {
   for (double beta : {120.0, 150.0, 180.0}) {
     double previous = 1.0, first = 0.0;
     for (int through : {1, 2, 4, 8}) {
-      Config c = make_deck(arch_deck("circular_arch", beta, through));
+      SceneParams c = make_deck(arch_deck("circular_arch", beta, through));
       Scene s = build_scene(c);
       const Model m = mesh_scene(s, c);
       const double exact = beta * kDeg * 0.2;
@@ -278,7 +281,7 @@ TEST(Scenes, ButtressDimensions) {
   // Buttressed circular arch, Rc = 1, t = 0.2, B = 0.8, H1 = 3, monolithic: blocks are the
   // 11 voussoirs, left buttress, right buttress, ground = 14 (13 free).
   for (double beta : {120.0, 150.0, 180.0}) {
-    const Config c = make_deck(
+    const SceneParams c = make_deck(
         "[model]\nkind = \"buttressed_arch\"\nshape = \"circular\"\nradius = 1.0\n"
         "thickness = 0.2\nembrace = " +
         std::to_string(beta) + "\nvoussoirs = 11\nbuttress_width = 0.8\nbase_depth = 3.0\n");
@@ -574,8 +577,8 @@ TEST(Scenes, GeometryErrorsNameTheKey) {
       EXPECT_NE(msg.find(b.why), std::string::npos) << msg;
     }
   }
-  // A Config built by hand (no deck validation): too few voussoirs.
-  Config c = make_deck(arch_deck("circular_arch", 180.0));
+  // Parameters built by hand (no deck validation): too few voussoirs.
+  SceneParams c = make_deck(arch_deck("circular_arch", 180.0));
   c.model.voussoirs = 0;
   EXPECT_THROW(build_model(c), DeckError);
 }
@@ -587,7 +590,8 @@ TEST(Scenes, ShippedDecksLoadAndMeshWell) {
                          "buttressed_basket", "church_a",    "church_b",
                          "gilbert_arch",      "scaled_arch", "block"};
   for (const char* name : names) {
-    const Config c = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/" + name + ".toml");
+    const SceneParams c =
+        scene_params(load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/" + name + ".toml"));
     const Model m = build_model(c);
     const double worst = worst_triangle_angle_deg(m);
     int free_blocks = 0;
@@ -598,6 +602,56 @@ TEST(Scenes, ShippedDecksLoadAndMeshWell) {
     EXPECT_GT(free_blocks, 0) << name;
     EXPECT_LT(mirror_error(m), 1e-12 * model_size(m)) << name;
   }
+}
+
+TEST(SceneKinds, TheDeckReaderAndTheBuilderFollowTheRegistry) {
+  // Every kind of core/scene_kinds.hpp is accepted by the deck reader, which asks for its
+  // required keys by name; an arch kind builds a scene with a centreline, the others none.
+  for (const SceneKind& kind : scene_kinds()) {
+    const std::string deck = arch_deck(kind.name, 150.0);
+    if (!kind.required.empty()) {
+      try {
+        make_deck(deck);
+        ADD_FAILURE() << kind.name << ": a deck without " << kind.required[0].key << " loaded";
+      } catch (const DeckError& e) {
+        EXPECT_NE(std::string(e.what()).find(kind.required[0].key), std::string::npos) << e.what();
+      }
+      continue;
+    }
+    const Scene s = build_scene(make_deck(deck));
+    EXPECT_EQ(s.kind, kind.name);
+    EXPECT_EQ(!s.centreline.empty(), kind.arch) << kind.name;
+    EXPECT_EQ(is_arch_kind(kind.name), kind.arch) << kind.name;
+  }
+  EXPECT_FALSE(is_arch_kind("no_such_kind"));
+  EXPECT_EQ(find_scene_kind("no_such_kind"), nullptr);
+}
+
+TEST(GridRectangle, LayoutDiagonalsAndOutline) {
+  // mesh/rectangle.hpp: node (i, j) at index j (nx + 1) + i; cell (1, 0) of the alternating
+  // grid takes the other diagonal; both patterns tile the rectangle; the outline is the four
+  // corners or every boundary node.
+  const TriMesh alt = mesh_grid_rectangle(1.0, 2.0, 2.0, 1.0, 2, 1);
+  const TriMesh uni = mesh_grid_rectangle(1.0, 2.0, 2.0, 1.0, 2, 1, GridDiagonals::Uniform);
+  ASSERT_EQ(alt.points.size(), 6u);
+  EXPECT_EQ(alt.points[4].x, 2.0);
+  EXPECT_EQ(alt.points[4].y, 3.0);
+  ASSERT_EQ(alt.tris.size(), 4u);
+  EXPECT_EQ(alt.tris[2], (std::array<Index, 3>{1, 2, 4}));
+  EXPECT_EQ(uni.tris[2], (std::array<Index, 3>{1, 2, 5}));
+  for (const TriMesh* m : {&alt, &uni}) {
+    double area = 0.0;
+    for (const auto& t : m->tris)
+      area += std::abs(polygon_area({m->points[t[0]], m->points[t[1]], m->points[t[2]]}));
+    EXPECT_DOUBLE_EQ(area, 2.0);
+  }
+  Model model;
+  add_grid_rectangle(model, 0.0, 0.0, 2.0, 1.0, 2, 1, false, "a");
+  add_grid_rectangle(model, 0.0, 1.0, 2.0, 1.0, 2, 1, true, "b", GridDiagonals::Uniform,
+                     GridOutline::Nodes);
+  EXPECT_EQ(model.blocks[0].polygon.size(), 4u);
+  EXPECT_EQ(model.blocks[1].polygon.size(), 6u);
+  EXPECT_TRUE(model.blocks[1].fixed);
 }
 
 }  // namespace

@@ -135,8 +135,8 @@ TEST(Speed, NegligibleOverlapRejectsOnlyDiscardedCornerTouches) {
 // the same strain energy for the same deformation (to round-off: the summation order changes).
 TEST(Speed, LocalityOrderingOnlyRenumbers) {
   Model m;
-  bench::add_grid_block(m, 0.0, 0.0, 0.6, 0.4, 30, 20, false, "big");   // 651 nodes: ordered
-  bench::add_grid_block(m, 0.0, -0.1, 0.6, 0.1, 6, 1, true, "ground");  // 14 nodes: kept
+  add_grid_rectangle(m, 0.0, 0.0, 0.6, 0.4, 30, 20, false, "big");   // 651 nodes: ordered
+  add_grid_rectangle(m, 0.0, -0.1, 0.6, 0.1, 6, 1, true, "ground");  // 14 nodes: kept
   finalize_model(m);
   Model o = m;
   order_for_locality(o);
