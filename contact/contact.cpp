@@ -754,6 +754,9 @@ std::int64_t ContactSystem::active_pairs() const {
 std::int64_t ContactSystem::detections() const {
   return impl_->detections;
 }
+const ContactParams& ContactSystem::params() const {
+  return impl_->params;
+}
 double ContactSystem::penalty() const {
   return impl_->penalty;
 }

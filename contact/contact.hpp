@@ -19,8 +19,8 @@ struct ContactParams {
   // Joint stiffness in engineering units (contact/joint_stiffness.hpp). normal_stiffness kn
   // [N/m3] > 0 replaces the single penalty by one per pair that gives kn on a flat joint;
   // joint_young E [Pa] > 0 (and kn = 0) takes kn = 100 E / l per pair instead (the rigid-block
-  // default, contact/joint_stiffness.hpp). shear_stiffness ks [N/m3]: tangential spring of the friction law; 0 = 1/4 of the
-  // normal stiffness (kTangentialStiffnessRatio).
+  // default, contact/joint_stiffness.hpp). shear_stiffness ks [N/m3]: tangential spring of the
+  // friction law; 0 = 1/4 of the normal stiffness (kTangentialStiffnessRatio).
   double normal_stiffness = 0.0;
   double joint_young = 0.0;
   double shear_stiffness = 0.0;
@@ -77,7 +77,8 @@ class ContactSystem {
 
   // Additions (contact helper):
   double penalty() const;  // Ep in use [Pa] (ContactParams::penalty, or 100 x Lame lambda if 0)
-  double buffer() const;   // NBS buffer in use [m]
+  const ContactParams& params() const;  // as given to setup
+  double buffer() const;                // NBS buffer in use [m]
 
   // Checkpoints (io/checkpoint.hpp). save_state: what evolves here -- the candidate pairs and
   // their friction slip, the positions of the free participant nodes at the last detection

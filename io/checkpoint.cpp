@@ -125,11 +125,17 @@ std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
   f.value(sim.contact.penalty());
   f.value(sim.contact.buffer());
   f.value(friction);
-  // Rigid blocks (issue 23): their bodies' mass and inertia. Elastic models hash as before.
+  // Rigid blocks and joint stiffness (issue 23): the bodies' mass and inertia, the joints'
+  // stiffness and restitution. Models without them hash as before.
   if (m.is_rigid()) {
     f.array(m.rigid.mass);
     f.array(m.rigid.inertia);
   }
+  const ContactParams& p = sim.contact.params();
+  if (p.normal_stiffness > 0.0 || p.joint_young > 0.0 || p.shear_stiffness > 0.0 ||
+      p.restitution < 1.0)
+    for (const double v : {p.normal_stiffness, p.joint_young, p.shear_stiffness, p.restitution})
+      f.value(v);
   return f.h;
 }
 

@@ -198,6 +198,17 @@ TEST(Rigid, RestartContinuesBitForBit) {
   EXPECT_GT(straight.ledger.impact_dissipated, 0.0);
 }
 
+TEST(Rigid, CheckpointFingerprintTellsJointsApart) {
+  const std::string deck = block_deck("friction = 0.8\nnormal_stiffness = 1e10");
+  const Simulation a = deck_sim(deck);
+  const Simulation b = deck_sim(deck, {"contact.normal_stiffness=2e10"});
+  const Simulation c = deck_sim(deck, {"contact.restitution=0.5"});
+  const Simulation d = deck_sim(deck, {"contact.shear_stiffness=1e9"});
+  const std::uint64_t fa = simulation_fingerprint(a, 0.8);
+  for (const Simulation* other : {&b, &c, &d}) EXPECT_NE(simulation_fingerprint(*other, 0.8), fa);
+  EXPECT_EQ(simulation_fingerprint(deck_sim(deck), 0.8), fa);
+}
+
 TEST(Rigid, NoStressFieldForRigidBlocks) {
   const Config c = parse_deck(block_deck("friction = 0.8"), "test");
   EXPECT_EQ(c.output.fields, (std::vector<std::string>{"position", "velocity"}));
