@@ -805,9 +805,7 @@ ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) c
     const bool partner_free = other != nullptr && !other->fixed;
     double kn = s.params.normal_stiffness;
     if (!(kn > 0.0) && s.params.joint_young > 0.0) {
-      const double lb = extent_along(blk.polygon, normal);
-      const double l = partner_free ? 0.5 * (lb + extent_along(other->polygon, normal)) : lb;
-      kn = kRigidJointFactor * s.params.joint_young / l;
+      kn = default_joint_stiffness(s.params.joint_young, blk, other, normal);
     } else if (!(kn > 0.0)) {
       // Penalty mode: Ep (3/h_b + 3/h_partner) with the smallest face heights.
       const double hb = s.block_min_height[std::size_t(b)];
@@ -830,11 +828,8 @@ ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) c
     stiffness[std::size_t(b)] += (partner_free ? 2.0 : 1.0) * a;
     has_face[std::size_t(b)] = 1;
     if (zeta > 0.0) {
-      double face = extent_along(blk.polygon, tangent);
-      if (other != nullptr) face = std::min(face, extent_along(other->polygon, tangent));
-      const double m = r.mass[b];
-      const double m_eff = partner_free ? m * other->mass / (m + other->mass) : m;
-      const double omega = std::sqrt(kn_t * face / m_eff);
+      const double omega = joint_frequency(kn_t, blk, r.mass[b], other,
+                                           other != nullptr ? other->mass : 0.0, tangent);
       beta_max[std::size_t(b)] = std::max(beta_max[std::size_t(b)], 2.0 * zeta / omega);
     }
   };

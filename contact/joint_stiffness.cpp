@@ -42,21 +42,12 @@ std::vector<std::pair<Vec2, Vec2>> boundary_edges(const Model& model, Index e) {
   return out;
 }
 
-double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  const double l2 = dx * dx + dy * dy;
-  const double s =
-      l2 > 0.0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / l2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - a.x - s * dx, p.y - a.y - s * dy);
-}
-
 FacingEdge edge_of(const Model& model, Index e, const std::pair<Vec2, Vec2>& edge) {
   FacingEdge f;
   const double ex = edge.second.x - edge.first.x, ey = edge.second.y - edge.first.y;
   f.length = std::hypot(ex, ey);
   f.height = 2.0 * model.tris.area0[e] / f.length;
   f.normal = {ey / f.length, -ex / f.length};
-  f.mid = {0.5 * (edge.first.x + edge.second.x), 0.5 * (edge.first.y + edge.second.y)};
   return f;
 }
 
@@ -74,15 +65,31 @@ std::pair<FacingEdge, FacingEdge> facing_edges(const Model& model, Index c, Inde
     for (const auto& b : et) {
       const FacingEdge fa = edge_of(model, c, a), fb = edge_of(model, t, b);
       if (!(fa.length > 0.0) || !(fb.length > 0.0)) continue;
-      const double dist = std::min({point_segment_distance(a.first, b.first, b.second),
-                                    point_segment_distance(a.second, b.first, b.second),
-                                    point_segment_distance(b.first, a.first, a.second),
-                                    point_segment_distance(b.second, a.first, a.second)});
+      const double dist = std::min({distance_to_segment(a.first, b.first, b.second),
+                                    distance_to_segment(a.second, b.first, b.second),
+                                    distance_to_segment(b.first, a.first, a.second),
+                                    distance_to_segment(b.second, a.first, a.second)});
       const double opposite = 1.0 + fa.normal.x * fb.normal.x + fa.normal.y * fb.normal.y;
       const double score = dist + 1e-3 * std::max(fa.length, fb.length) * opposite;
       if (score < best_score) best_score = score, best = {fa, fb};
     }
   return best;
+}
+
+double default_joint_stiffness(double young, const Block& a, const Block* b, const Vec2& normal) {
+  const double la = extent_along(a.polygon, normal);
+  if (b == nullptr || b->fixed) return kRigidJointFactor * young / la;
+  const double lb = extent_along(b->polygon, normal);
+  return kRigidJointFactor * young / (a.fixed ? lb : 0.5 * (la + lb));
+}
+
+double joint_frequency(double kn_thickness, const Block& a, double mass_a, const Block* b,
+                       double mass_b, const Vec2& tangent) {
+  double face = extent_along(a.polygon, tangent);
+  if (b != nullptr) face = std::min(face, extent_along(b->polygon, tangent));
+  double m_eff = mass_a;
+  if (b != nullptr && !b->fixed) m_eff = a.fixed ? mass_b : mass_a * mass_b / (mass_a + mass_b);
+  return m_eff > 0.0 ? std::sqrt(kn_thickness * face / m_eff) : 0.0;
 }
 
 PairJoint pair_joint(const Model& model, Index c, Index t, double kn_given, double young,
@@ -96,27 +103,15 @@ PairJoint pair_joint(const Model& model, Index c, Index t, double kn_given, doub
   if (kn_given > 0.0) {
     r.kn = kn_given;
   } else if (young > 0.0) {
-    const double lc = extent_along(bc.polygon, fc.normal);
-    const double lt = extent_along(bt.polygon, fc.normal);
-    double l = 0.5 * (lc + lt);
-    if (bc.fixed != bt.fixed) l = bc.fixed ? lt : lc;
-    r.kn = kRigidJointFactor * young / l;
+    r.kn = default_joint_stiffness(young, bc, &bt, fc.normal);
   } else {
     r.kn = penalty * g;
   }
   r.ep = r.kn / g;
   const double ks = ks_given > 0.0 ? ks_given : kTangentialStiffnessRatio * r.kn;
   r.kt = ks * thickness * std::min(fc.length, ft.length);
-  // Joint frequency: the lighter body on the shorter face.
-  const Vec2 tangent{-fc.normal.y, fc.normal.x};
-  const double face =
-      std::min(extent_along(bc.polygon, tangent), extent_along(bt.polygon, tangent));
-  double m_eff = 0.0;
-  if (!bc.fixed && !bt.fixed)
-    m_eff = bc.mass * bt.mass / (bc.mass + bt.mass);
-  else
-    m_eff = bc.fixed ? bt.mass : bc.mass;
-  if (m_eff > 0.0) r.omega = std::sqrt(r.kn * thickness * face / m_eff);
+  r.omega =
+      joint_frequency(r.kn * thickness, bc, bc.mass, &bt, bt.mass, Vec2{-fc.normal.y, fc.normal.x});
   return r;
 }
 

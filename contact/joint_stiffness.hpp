@@ -72,18 +72,26 @@ struct FacingEdge {
   double length = 0.0;  // [m]
   double height = 0.0;  // triangle height over it [m]
   Vec2 normal;          // outward unit normal
-  Vec2 mid;             // mid-point [m]
 };
 
 // The facing edges of the pair (c, t) (above).
 std::pair<FacingEdge, FacingEdge> facing_edges(const Model& model, Index c, Index t);
-
 
 // Extent of a polygon along a unit direction (max - min of the projections) [m].
 double extent_along(const std::vector<Vec2>& polygon, const Vec2& direction);
 
 // Damping ratio of the restitution e in [0, 1] (above); 0 at e = 1.
 double restitution_damping_ratio(double e);
+
+// kn = kRigidJointFactor x E / l of a joint of unit normal `normal` between block a and block b
+// (b == nullptr: a fixed support with no outline) [N/m3] (above).
+double default_joint_stiffness(double young, const Block& a, const Block* b, const Vec2& normal);
+
+// Joint frequency sqrt(kn t_z L / m_eff) [1/s] (above): L the shorter of the two blocks'
+// extents along `tangent`, m_eff from their masses (a fixed block's does not count; b ==
+// nullptr: a fixed support). kn_thickness = kn t_z [N/m3 m].
+double joint_frequency(double kn_thickness, const Block& a, double mass_a, const Block* b,
+                       double mass_b, const Vec2& tangent);
 
 // Mapping and damping parameters of one pair (c, t).
 struct PairJoint {

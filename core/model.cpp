@@ -126,6 +126,14 @@ void finalize_model(Model& model) {
   }
 }
 
+double distance_to_segment(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 ab = b - a;
+  const double len2 = dot(ab, ab);
+  if (len2 == 0.0) return distance(p, a);
+  const double s = std::clamp(dot(p - a, ab) / len2, 0.0, 1.0);
+  return distance(p, a + s * ab);
+}
+
 double min_triangle_height(const Model& model) {
   const Nodes& n = model.nodes;
   const Triangles& t = model.tris;

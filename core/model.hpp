@@ -13,6 +13,7 @@
 // Units: SI (m, kg, s, N, Pa); per unit out-of-plane thickness times `out_of_plane`.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -25,6 +26,31 @@ struct Vec2 {
   double x = 0.0;
   double y = 0.0;
 };
+
+// Small vector helpers (scene generators, minimal meshes, joint stiffness).
+inline Vec2 operator+(Vec2 a, Vec2 b) {
+  return {a.x + b.x, a.y + b.y};
+}
+inline Vec2 operator-(Vec2 a, Vec2 b) {
+  return {a.x - b.x, a.y - b.y};
+}
+inline Vec2 operator*(double s, Vec2 a) {
+  return {s * a.x, s * a.y};
+}
+inline double dot(Vec2 a, Vec2 b) {
+  return a.x * b.x + a.y * b.y;
+}
+inline double cross(Vec2 a, Vec2 b) {
+  return a.x * b.y - a.y * b.x;
+}
+inline double norm(Vec2 a) {
+  return std::hypot(a.x, a.y);
+}
+inline double distance(Vec2 a, Vec2 b) {
+  return std::hypot(a.x - b.x, a.y - b.y);
+}
+// Distance from p to the segment a-b.
+double distance_to_segment(Vec2 p, Vec2 a, Vec2 b);
 
 // Elastic material; the law itself lives in core/cst.hpp.
 struct Material {

@@ -4,14 +4,6 @@
 
 namespace voussoir {
 
-double distance_to_segment(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double len2 = dot(ab, ab);
-  if (len2 == 0.0) return distance(p, a);
-  const double s = std::clamp(dot(p - a, ab) / len2, 0.0, 1.0);
-  return distance(p, a + s * ab);
-}
-
 double outline_area(const Outline& outline) {
   const std::size_t n = outline.size();
   double twice = 0.0, segments = 0.0;

@@ -22,27 +22,6 @@
 
 namespace voussoir {
 
-inline Vec2 operator+(Vec2 a, Vec2 b) {
-  return {a.x + b.x, a.y + b.y};
-}
-inline Vec2 operator-(Vec2 a, Vec2 b) {
-  return {a.x - b.x, a.y - b.y};
-}
-inline Vec2 operator*(double s, Vec2 a) {
-  return {s * a.x, s * a.y};
-}
-inline double dot(Vec2 a, Vec2 b) {
-  return a.x * b.x + a.y * b.y;
-}
-inline double cross(Vec2 a, Vec2 b) {
-  return a.x * b.y - a.y * b.x;
-}
-inline double norm(Vec2 a) {
-  return std::hypot(a.x, a.y);
-}
-inline double distance(Vec2 a, Vec2 b) {
-  return std::hypot(a.x - b.x, a.y - b.y);
-}
 // Mirror image in the vertical axis x = 0 (exact: only the sign bit changes).
 inline Vec2 mirror_x(Vec2 p) {
   return {-p.x, p.y};
@@ -53,8 +32,6 @@ inline Vec2 mirror_x(Vec2 p) {
 inline Vec2 on_circle(Vec2 centre, double radius, double theta) {
   return {std::fma(radius, std::cos(theta), centre.x), std::fma(radius, std::sin(theta), centre.y)};
 }
-// Distance from p to the segment a-b.
-double distance_to_segment(Vec2 p, Vec2 a, Vec2 b);
 
 // One edge of an exact outline: from `start` to the next edge's start (cyclically).
 struct OutlineEdge {

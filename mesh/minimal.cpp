@@ -11,17 +11,9 @@ namespace voussoir {
 
 namespace {
 
-double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
-  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-}
-
-// Distance from p to the segment a-b [m].
-double distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  const double l2 = dx * dx + dy * dy;
-  double s = l2 > 0.0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / l2 : 0.0;
-  s = std::clamp(s, 0.0, 1.0);
-  return std::hypot(p.x - a.x - s * dx, p.y - a.y - s * dy);
+// Twice the signed area of the triangle o, a, b (> 0 counter-clockwise).
+double turn(const Vec2& o, const Vec2& a, const Vec2& b) {
+  return cross(a - o, b - o);
 }
 
 // Smallest extent of the polygon across the normals of its sides [m].
@@ -93,12 +85,12 @@ std::vector<std::array<Index, 3>> ear_clip(const std::vector<Vec2>& poly) {
     double best_angle = -1.0;
     for (std::size_t k = 0; k < m; ++k) {
       const Vec2 &a = poly[ring[(k + m - 1) % m]], &b = poly[ring[k]], &c = poly[ring[(k + 1) % m]];
-      if (!(cross(a, b, c) > 0.0)) continue;  // reflex or flat: not an ear
+      if (!(turn(a, b, c) > 0.0)) continue;  // reflex or flat: not an ear
       bool empty = true;
       for (std::size_t j = 0; j < m && empty; ++j) {
         if (j == k || j == (k + 1) % m || j == (k + m - 1) % m) continue;
         const Vec2& p = poly[ring[j]];
-        empty = !(cross(a, b, p) >= 0.0 && cross(b, c, p) >= 0.0 && cross(c, a, p) >= 0.0);
+        empty = !(turn(a, b, p) >= 0.0 && turn(b, c, p) >= 0.0 && turn(c, a, p) >= 0.0);
       }
       if (!empty) continue;
       const double angle = min_angle_deg(a, b, c);

@@ -246,13 +246,8 @@ TEST(MinimalMesh, AnArcKeepsThePointsItsSagittaAsksFor) {
   // Every original point within 1% of the thickness of the simplified outline.
   for (const Vec2& p : outline) {
     double d = 1e9;
-    for (std::size_t k = 0; k < fine.size(); ++k) {
-      const Vec2 &a = fine[k], &b = fine[(k + 1) % fine.size()];
-      const double dx = b.x - a.x, dy = b.y - a.y;
-      const double t =
-          std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
-      d = std::min(d, std::hypot(p.x - a.x - t * dx, p.y - a.y - t * dy));
-    }
+    for (std::size_t k = 0; k < fine.size(); ++k)
+      d = std::min(d, distance_to_segment(p, fine[k], fine[(k + 1) % fine.size()]));
     EXPECT_LE(d, 0.01 * 0.2 + 1e-12);
   }
   EXPECT_EQ(ear_clip(fine).size(), fine.size() - 2);
