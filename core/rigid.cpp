@@ -78,6 +78,7 @@ double integrate_rigid_bodies(Model& model, double dt) {
   Nodes& n = model.nodes;
   RigidBodies& r = model.rigid;
   double twice_kinetic = 0.0;
+  const double inv_dt = 1.0 / dt;
   const Index nb = static_cast<Index>(model.blocks.size());
   for (Index b = 0; b < nb; ++b) {
     const Block& blk = model.blocks[b];
@@ -102,7 +103,6 @@ double integrate_rigid_bodies(Model& model, double dt) {
     r.cy[b] = cy + dt * uy;
     r.theta[b] += dt * w;
     const double cs = std::cos(r.theta[b]), sn = std::sin(r.theta[b]);
-    const double inv_dt = 1.0 / dt;
     for (Index i = begin; i < end; ++i) {
       const double x = r.cx[b] + cs * r.rx[i] - sn * r.ry[i];
       const double y = r.cy[b] + sn * r.rx[i] + cs * r.ry[i];

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "contact/friction.hpp"
+#include "contact/joint_stiffness.hpp"
 #include "core/model.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/setup.hpp"
@@ -83,18 +85,21 @@ int command_check(const Config& config, const CommonOptions& common, const Check
               m.out_of_plane);
   std::printf("worst angle %.2f deg\n", worst);
   std::printf("blocks are  %s\n", info.rigid ? "rigid (one body each; no strain energy, no stress "
-                                              "field)"
-                                            : "elastic (constant-strain triangles)");
-  std::printf("dt          %.4g s (stable limit %.4g s, set by the %s)\n", info.dt,
-              info.dt_stable, info.dt_set_by.c_str());
+                                               "field)"
+                                             : "elastic (constant-strain triangles)");
+  std::printf("dt          %.4g s (stable limit %.4g s, set by the %s)\n", info.dt, info.dt_stable,
+              info.dt_set_by.c_str());
   if (info.joint_stiffness) {
     if (config.contact.normal_stiffness > 0.0)
       std::printf("joints      kn = %.4g N/m3, ks = %.4g N/m3\n", config.contact.normal_stiffness,
-                  config.contact.shear_stiffness > 0.0 ? config.contact.shear_stiffness
-                                                       : 0.25 * config.contact.normal_stiffness);
+                  config.contact.shear_stiffness > 0.0
+                      ? config.contact.shear_stiffness
+                      : kTangentialStiffnessRatio * config.contact.normal_stiffness);
     else
-      std::printf("joints      kn = 100 E / l per joint (l: the blocks' length normal to it), ks = %s\n",
-                  config.contact.shear_stiffness > 0.0 ? "contact.shear_stiffness" : "kn / 4");
+      std::printf(
+          "joints      kn = %g E / l per joint (l: the blocks' length normal to it), ks = %s\n",
+          kRigidJointFactor,
+          config.contact.shear_stiffness > 0.0 ? "contact.shear_stiffness" : "kn / 4");
   } else {
     std::printf("penalty     %.4g Pa\n", info.penalty);
   }

@@ -43,15 +43,20 @@
 
 namespace voussoir {
 
-bool ContactConfig::has(const std::string& key) const {
-  const std::string leaf = key.rfind("contact.", 0) == 0 ? key.substr(8) : key;
+// Whether `key` ("embrace" or "model.embrace") is among the keys of `section` the deck gave.
+static bool section_has(const std::vector<std::string>& given, const std::string& section,
+                        const std::string& key) {
+  const std::string prefix = section + ".";
+  const std::string leaf = key.rfind(prefix, 0) == 0 ? key.substr(prefix.size()) : key;
   return std::find(given.begin(), given.end(), leaf) != given.end();
 }
 
+bool ContactConfig::has(const std::string& key) const {
+  return section_has(given, "contact", key);
+}
+
 bool ModelConfig::has(const std::string& key) const {
-  // Accepts "embrace" as well as "model.embrace".
-  const std::string leaf = key.rfind("model.", 0) == 0 ? key.substr(6) : key;
-  return std::find(given.begin(), given.end(), leaf) != given.end();
+  return section_has(given, "model", key);
 }
 
 namespace {
