@@ -98,6 +98,11 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   capacity->add_option("--max-time", cap_opts.criteria.max_time, "trial time limit [s]")
       ->check(CLI::PositiveNumber);
+  capacity->add_option("--direction", cap_opts.direction,
+                       "direction of lambda g: +x, -x, or both (reports each and the smaller)")
+      ->check(CLI::IsMember({"+x", "-x", "both"}));
+  capacity->add_flag("--dynamic", cap_opts.dynamic,
+                     "physical settle and trials: no quasi-static local damping");
   capacity->add_option("--settle-time", cap_opts.criteria.settle_max_time,
                        "longest settle under gravity before the trials [s]")
       ->capture_default_str()
@@ -144,6 +149,8 @@ int main(int argc, char** argv) {
                     "longest settle under gravity before each cell's trials [s]")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  sweep->add_flag("--dynamic", sweep_opts.dynamic,
+                  "physical settle and trials: no quasi-static local damping");
   sweep->add_option("--resume", sweep_opts.resume,
                     "journal of finished cells: created, or resumed after a kill");
   sweep->add_option("--points", sweep_opts.points, "trial lambdas per round (default 2)")

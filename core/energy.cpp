@@ -12,7 +12,7 @@ double EnergyLedger::balance_error() const {
 
 void EnergyLedger::update_max() {
   max_energy = std::max({max_energy, std::abs(external_work), kinetic, strain, contact,
-                         damping_dissipated + friction_dissipated + impact_dissipated});
+                         dissipated()});
 }
 
 }  // namespace voussoir

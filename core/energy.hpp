@@ -13,11 +13,15 @@ struct EnergyLedger {
   double damping_dissipated = 0.0;   // accumulated: Munjiza viscous term
   double friction_dissipated = 0.0;  // accumulated: Coulomb slip
   double impact_dissipated = 0.0;    // accumulated: contact normal damping (restitution < 1)
+  // accumulated: Cundall's local damping of the quasi-static phases (capacity and sweep
+  // trials, core/integrate.hpp LocalDamping); 0 in the physical runs (run, pulse, stability),
+  // so checkpoints do not carry it
+  double local_dissipated = 0.0;
   double max_energy = 0.0;           // largest of the terms seen so far (normalises the error)
 
   double stored() const { return kinetic + strain + contact; }
   double dissipated() const {
-    return damping_dissipated + friction_dissipated + impact_dissipated;
+    return damping_dissipated + friction_dissipated + impact_dissipated + local_dissipated;
   }
   // |W - K - U - C - D| / max energy seen (0 before anything happened).
   double balance_error() const;

@@ -55,6 +55,29 @@ inline void update_nodes(const NodeArrays& a, double dt, Index begin, Index end,
   twice_kinetic = k2;
 }
 
+// update_nodes with local damping: force f + d (integrate.hpp LocalDamping), d^(n-1) in
+// `previous` (2 per node); adds m v^- . v^+ into sums.x and the dissipated energy into sums.y.
+inline void update_nodes_damped(const NodeArrays& a, double dt, double alpha, double* previous,
+                                Index begin, Index end, Vec2& sums) {
+  double k2 = sums.x, work = sums.y;
+  for (Index i = begin; i < end; ++i) {
+    const double dx = local_damping_force(alpha, a.fx[i], a.vx[i]);
+    const double dy = local_damping_force(alpha, a.fy[i], a.vy[i]);
+    work -= 0.5 * dt * ((dx + previous[2 * i]) * a.vx[i] + (dy + previous[2 * i + 1]) * a.vy[i]);
+    previous[2 * i] = dx;
+    previous[2 * i + 1] = dy;
+    const double h = dt * a.inv_mass[i];
+    const double ux = a.vx[i] + h * (a.fx[i] + dx);
+    const double uy = a.vy[i] + h * (a.fy[i] + dy);
+    k2 += a.mass[i] * (a.vx[i] * ux + a.vy[i] * uy);
+    a.vx[i] = ux;
+    a.vy[i] = uy;
+    a.x[i] += dt * ux;
+    a.y[i] += dt * uy;
+  }
+  sums = Vec2{k2, work};
+}
+
 }  // namespace
 
 void clear_forces(Nodes& nodes) {
@@ -76,6 +99,20 @@ double integrate_central_difference(Model& model, double dt) {
   return 0.5 * sum_over_free_nodes<double>(model, [&a, dt](Index begin, Index end, double& k2) {
            update_nodes(a, dt, begin, end, k2);
          });
+}
+
+double integrate_central_difference(Model& model, double dt, LocalDamping& damping) {
+  const NodeArrays a = arrays_of(model.nodes);
+  std::vector<double>& previous = *damping.previous;
+  previous.resize(2 * model.nodes.x.size(), 0.0);
+  double* prev = previous.data();
+  const double alpha = damping.alpha;
+  const Vec2 sums =
+      sum_over_free_nodes<Vec2>(model, [&a, dt, alpha, prev](Index begin, Index end, Vec2& s) {
+        update_nodes_damped(a, dt, alpha, prev, begin, end, s);
+      });
+  damping.dissipated = sums.y;
+  return 0.5 * sums.x;
 }
 
 }  // namespace voussoir

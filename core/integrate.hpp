@@ -16,9 +16,35 @@
 // highest mesh mode at the usual step), which would show as a spurious balance error.
 // K^n can dip below zero only when a velocity reverses within one step by more than it was.
 
+#include <cmath>
+#include <vector>
+
 #include "core/model.hpp"
 
 namespace voussoir {
+
+// Cundall's local non-viscous damping (the static mode of UDEC and 3DEC), used by the
+// quasi-static phases of `capacity` and `sweep` (docs/capacity.md, "Quasi-static decisions"):
+// on every degree of freedom (a node's x and y; a rigid block's x, y and rotation) the
+// unbalanced force f^n of the step gets a damping force
+//     d^n = -alpha |f^n| sign(v^(n-1/2)),
+// opposed to the motion and proportional to the force, not to the speed, so it damps every
+// mode alike whatever its frequency, and vanishes at equilibrium. The dissipated energy is the
+// trapezoidal work of the ledger (integrate.hpp header):
+//     D += -dt/2 (d^n + d^(n-1)) . v^(n-1/2)
+// exact with the leapfrog K^n, so the balance still closes.
+struct LocalDamping {
+  double alpha = 0.0;                 // coefficient, 0 <= alpha < 1
+  std::vector<double>* previous = nullptr;  // d^(n-1) per degree of freedom (sized on use)
+  double dissipated = 0.0;            // out: energy dissipated by this step [J]
+};
+
+// The damping force of one degree of freedom (above).
+inline double local_damping_force(double alpha, double force, double velocity) {
+  if (velocity > 0.0) return -alpha * std::abs(force);
+  if (velocity < 0.0) return alpha * std::abs(force);
+  return 0.0;
+}
 
 // Clears the force accumulators of every node (on the OpenMP threads for large models).
 void clear_forces(Nodes& nodes);
@@ -26,5 +52,8 @@ void clear_forces(Nodes& nodes);
 // Velocity then position update of the nodes of free blocks; returns K^n above [J]. Threaded
 // above a size threshold, bit-identical for any thread count (integrate.cpp).
 double integrate_central_difference(Model& model, double dt);
+
+// Same with local damping (damping.alpha > 0); books damping.dissipated.
+double integrate_central_difference(Model& model, double dt, LocalDamping& damping);
 
 }  // namespace voussoir

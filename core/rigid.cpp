@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "core/integrate.hpp"
+
 namespace voussoir {
 
 double triangle_polar_inertia(double rho_a, const Vec2& p0, const Vec2& p1, const Vec2& p2,
@@ -74,7 +76,12 @@ void set_rigid_state(Model& model, Index b, double cx, double cy, double theta, 
   }
 }
 
-double integrate_rigid_bodies(Model& model, double dt) {
+namespace {
+
+// The body update of integrate_rigid_bodies; `damping` (3 per body: x, y, rotation) when the
+// local damping is on (core/integrate.hpp LocalDamping), books its work into `dissipated`.
+double update_rigid_bodies(Model& model, double dt, double alpha, double* previous,
+                           double& dissipated) {
   Nodes& n = model.nodes;
   RigidBodies& r = model.rigid;
   double twice_kinetic = 0.0;
@@ -91,6 +98,17 @@ double integrate_rigid_bodies(Model& model, double dt) {
       fx += n.fx[i];
       fy += n.fy[i];
       torque += (n.x[i] - cx) * n.fy[i] - (n.y[i] - cy) * n.fx[i];
+    }
+    if (previous) {
+      double* d_prev = previous + 3 * b;
+      const double dx = local_damping_force(alpha, fx, r.vx[b]);
+      const double dy = local_damping_force(alpha, fy, r.vy[b]);
+      const double dr = local_damping_force(alpha, torque, r.omega[b]);
+      dissipated -= 0.5 * dt *
+                    ((dx + d_prev[0]) * r.vx[b] + (dy + d_prev[1]) * r.vy[b] +
+                     (dr + d_prev[2]) * r.omega[b]);
+      d_prev[0] = dx, d_prev[1] = dy, d_prev[2] = dr;
+      fx += dx, fy += dy, torque += dr;
     }
     const double ux = r.vx[b] + dt * fx / r.mass[b];
     const double uy = r.vy[b] + dt * fy / r.mass[b];
@@ -113,6 +131,20 @@ double integrate_rigid_bodies(Model& model, double dt) {
     }
   }
   return 0.5 * twice_kinetic;
+}
+
+}  // namespace
+
+double integrate_rigid_bodies(Model& model, double dt) {
+  double unused = 0.0;
+  return update_rigid_bodies(model, dt, 0.0, nullptr, unused);
+}
+
+double integrate_rigid_bodies(Model& model, double dt, LocalDamping& damping) {
+  damping.previous->resize(3 * model.blocks.size(), 0.0);
+  damping.dissipated = 0.0;
+  return update_rigid_bodies(model, dt, damping.alpha, damping.previous->data(),
+                             damping.dissipated);
 }
 
 }  // namespace voussoir

@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/integrate.hpp"
 #include "core/model.hpp"
 
 namespace voussoir {
@@ -52,6 +53,10 @@ void make_blocks_rigid(Model& model);
 // Central-difference update of the rigid blocks from the nodal forces of the step; moves their
 // nodes and sets the node velocities to the chord velocities. Returns K^n [J] (above).
 double integrate_rigid_bodies(Model& model, double dt);
+
+// Same with Cundall's local damping on each body's x, y and rotation (core/integrate.hpp
+// LocalDamping; damping.alpha > 0): books damping.dissipated.
+double integrate_rigid_bodies(Model& model, double dt, LocalDamping& damping);
 
 // Places rigid block b at centroid (cx, cy) and rotation theta with velocity (vx, vy, omega),
 // its nodes and their velocities with it (initial states of tests and studies).

@@ -113,6 +113,9 @@ struct CapacityConfig {
   double lambda_min = 0.0;             // bracket; both 0 = automatic
   double lambda_max = 0.0;
   double tolerance = 0.005;            // relative bracket width
+  // Cundall's local damping coefficient of the quasi-static settle and trials of `capacity`
+  // and `sweep` (docs/capacity.md "Quasi-static decisions"; `--dynamic`: none), in [0, 1)
+  double local_damping = 0.8;
 };
 
 struct OutputConfig {

@@ -126,8 +126,16 @@ void advance(Simulation& sim) {
   clock.stamp(timers.loads);
 
   // 6. central difference: v then x (of the nodes, or of the rigid bodies and their nodes)
-  const double kinetic =
-      rigid ? integrate_rigid_bodies(model, ctx.dt) : integrate_central_difference(model, ctx.dt);
+  double kinetic = 0.0;
+  if (ctx.local_damping > 0.0) {
+    LocalDamping damping{ctx.local_damping, &sim.local_damping_previous};
+    kinetic = rigid ? integrate_rigid_bodies(model, ctx.dt, damping)
+                    : integrate_central_difference(model, ctx.dt, damping);
+    ledger.local_dissipated += damping.dissipated;
+  } else {
+    kinetic = rigid ? integrate_rigid_bodies(model, ctx.dt)
+                    : integrate_central_difference(model, ctx.dt);
+  }
   clock.stamp(timers.integrate);
 
   // Energy ledger.

@@ -8,6 +8,7 @@
 //   4. contact forces (potential penalty + Coulomb friction)       contact/
 //   5. body loads (gravity, lambda g, base motion)                 core/loads
 //   6. central-difference integration (v then x), kinetic energy   core/integrate
+//      (with the local damping of the quasi-static phases when ctx.local_damping > 0)
 
 #include <array>
 #include <vector>
@@ -29,6 +30,9 @@ struct StepContext {
   double shear_modulus = 0.0;
   double eta = 0.0;  // Munjiza viscosity [Pa s]
   bool contact_on = true;
+  // Cundall's local damping coefficient alpha of the quasi-static phases (core/integrate.hpp
+  // LocalDamping); 0 = off (every physical run)
+  double local_damping = 0.0;
   // Body acceleration of the previous step, for the trapezoidal external work (core/loads.hpp);
   // set by advance(), not by drivers.
   double prev_body_ax = 0.0;
@@ -52,6 +56,9 @@ struct Simulation {
   // add_element_forces) for the exact damping work of the ledger; sized by advance(), empty
   // when undamped.
   std::vector<double> viscous_piola;
+  // Local damping force of the previous step per degree of freedom (core/integrate.hpp
+  // LocalDamping); empty while ctx.local_damping is 0.
+  std::vector<double> local_damping_previous;
   // Scratch of the threaded element stage (core/cst.hpp), built at the first large step.
   ElementWorkspace element_work;
 };

@@ -31,6 +31,7 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   const auto t0 = Clock::now();
   SettledState s;
   s.sim = make_simulation(config);
+  if (crit.quasi_static) s.sim.ctx.local_damping = config.capacity.local_damping;
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
   Simulation& sim = s.sim;
@@ -105,7 +106,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   spec.label = label;
   spec.loads = LoadProgram{};
   spec.loads->gravity = g;
-  spec.loads->lambda = lambda;
+  spec.loads->lambda = crit.direction * lambda;
   spec.loads->lambda_ramp = crit.ramp_time;
   spec.loads->start = sim.ctx.time;
   spec.limits = crit.limits;
@@ -165,6 +166,8 @@ std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
   for (double v : {s.sim.ctx.dt, s.sim.ctx.eta, s.gravity, c.ramp_time, c.collapse_displacement,
                    c.collapse_rotation, c.rest_speed, c.hold_time, c.max_time})
     f.value(v);
+  if (s.sim.ctx.local_damping > 0.0) f.value(s.sim.ctx.local_damping);
+  if (c.direction != 1.0) f.value(c.direction);
   return f.hex();
 }
 
@@ -311,8 +314,10 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     have_hi = round[0].collapsed;
     if (!have_hi) lo = hi;
   } else if (search.seed_from_limit) {
-    const LimitResult la =
-        limit_analysis(settled.sim.model, config.contact.friction, settled.gravity, false);
+    LimitOptions la_options;
+    la_options.direction = crit.direction;
+    const LimitResult la = limit_analysis(settled.sim.model, config.contact.friction,
+                                          settled.gravity, false, la_options);
     res.seed.status = la.status;
     if (la.status == "optimal" && la.lambda_la > lo) {
       res.seed.used = true;

@@ -44,6 +44,11 @@ struct TrialCriteria {
   double hold_time = 0.1;              // [s]
   double max_time = 3.0;               // [s] of simulated time after settling
   double settle_max_time = 5.0;        // [s]; a collapse under gravity ends it sooner
+  // Quasi-static settle and trials: Cundall's local damping with the deck's
+  // capacity.local_damping (docs/capacity.md). capacity and sweep set it unless --dynamic;
+  // false (the physical settle) for the pulse curve's and the stability map's settles.
+  bool quasi_static = false;
+  double direction = 1.0;              // of lambda g: +1 towards +x, -1 towards -x
   RunLimits limits;                    // guards and the user's limits (drivers/trial.hpp)
 };
 

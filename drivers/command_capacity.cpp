@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "drivers/capacity.hpp"
@@ -28,17 +30,10 @@ nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
   return out;
 }
 
-int command_capacity(const Config& config, const CommonOptions& common,
-                     const CapacityOptions& opts) {
-  TrialCriteria criteria = opts.criteria;
-  criteria.limits = common.limits;
-  CapacitySearch search;
-  search.points = opts.points;
-  search.quiet = common.quiet;
-  search.seed_from_limit = !opts.no_seed;
-  search.journal = opts.resume;
-  const CapacityResult res = find_capacity(config, criteria, search);
+namespace {
 
+// The text report of one search: lambda*, the seed, and the hinges of the failure mode.
+void print_capacity(const CapacityResult& res, const CapacityOptions& opts) {
   std::printf("lambda* = %.4f  bracket [%.4f, %.4f]  %zu trials  %.1f s wall\n", res.lambda_star,
               res.lo, res.hi, res.trials.size(), res.wall_s);
   if (res.seed.used)
@@ -57,58 +52,118 @@ int command_capacity(const Config& config, const CommonOptions& common,
     if (!h.side.empty()) std::printf(", pivot at %s", h.side.c_str());
     std::printf(" (%.4f, %.4f)\n", h.x, h.y);
   }
+}
 
+// The JSON of one search (SPEC.md section 2).
+nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& opts) {
+  nlohmann::json runs = nlohmann::json::array();
+  for (const TrialResult& r : res.trials)
+    runs.push_back({{"lambda", r.lambda},
+                    {"collapsed", r.collapsed},
+                    {"reason", r.reason},
+                    {"sim_time", r.sim_time},
+                    {"steps", r.steps},
+                    {"wall_s", r.wall_s},
+                    {"max_displacement", r.max_displacement},
+                    {"max_rotation", r.max_rotation},
+                    {"energy_balance_error", r.energy_balance_error}});
+  return {{"lambda_star", res.lambda_star},
+          {"bracket", {res.lo, res.hi}},
+          {"bracketed", res.bracketed},
+          {"tolerance", res.tolerance},
+          {"runs", runs},
+          {"triangles", res.triangles},
+          {"dt", res.dt},
+          {"wall_s", res.wall_s},
+          {"points_per_round", opts.points},
+          {"hinges", hinges_to_json(res.hinges)},
+          {"resumed_trials", res.resumed_trials},
+          {"seed",
+           {{"used", res.seed.used},
+            {"limit_status", res.seed.status},
+            {"lambda_la",
+             res.seed.used ? nlohmann::json(res.seed.lambda_la) : nlohmann::json(nullptr)},
+            {"held", res.seed.held},
+            {"widenings", res.seed.widenings},
+            {"unseeded_trials_estimate", res.seed.unseeded_trials},
+            {"trials_saved", res.seed.used ? res.seed.unseeded_trials -
+                                                 static_cast<int>(res.trials.size())
+                                           : 0}}}};
+}
+
+// The failure-mode JSON and picture of the governing search.
+void write_mode(const CapacityResult& res, const CapacityOptions& opts) {
   if ((!opts.mode_out.empty() || !opts.picture.empty()) && !res.has_mode)
     std::fprintf(stderr, "voussoir: no failure-mode picture: %s\n",
                  res.bracketed ? "the collapsed trial came from the journal" : "no collapse found");
-  if (res.has_mode) {
-    const nlohmann::json mode = failure_mode_json(res.mode, res.hinges);
-    if (!opts.mode_out.empty()) write_json(mode, opts.mode_out);
-    if (!opts.picture.empty()) {
-      const std::string tmp = opts.picture + ".mode.json";
-      write_json(mode, tmp);
-      char title[160];
-      std::snprintf(title, sizeof title, "failure mode at lambda = %.4f (lambda* = %.4f)", res.hi,
-                    res.lambda_star);
-      draw_with_script("draw", {tmp, "-o", opts.picture, "--no-mesh", "--title", title},
-                       opts.picture);
-      std::remove(tmp.c_str());
-    }
+  if (!res.has_mode) return;
+  const nlohmann::json mode = failure_mode_json(res.mode, res.hinges);
+  if (!opts.mode_out.empty()) write_json(mode, opts.mode_out);
+  if (!opts.picture.empty()) {
+    const std::string tmp = opts.picture + ".mode.json";
+    write_json(mode, tmp);
+    char title[160];
+    std::snprintf(title, sizeof title, "failure mode at lambda = %.4f (lambda* = %.4f)", res.hi,
+                  res.lambda_star);
+    draw_with_script("draw", {tmp, "-o", opts.picture, "--no-mesh", "--title", title},
+                     opts.picture);
+    std::remove(tmp.c_str());
   }
+}
+
+}  // namespace
+
+int command_capacity(const Config& config, const CommonOptions& common,
+                     const CapacityOptions& opts) {
+  TrialCriteria criteria = opts.criteria;
+  criteria.limits = common.limits;
+  criteria.quasi_static = !opts.dynamic;
+  CapacitySearch search;
+  search.points = opts.points;
+  search.quiet = common.quiet;
+  search.seed_from_limit = !opts.no_seed;
+  search.journal = opts.resume;
+
+  // One search per direction asked (`--direction both`: +x then -x, each with its own
+  // settle, seed and journal; the smaller lambda* governs).
+  std::vector<std::string> directions;
+  if (opts.direction == "both")
+    directions = {"+x", "-x"};
+  else
+    directions = {opts.direction};
+  std::vector<CapacityResult> results;
+  for (const std::string& d : directions) {
+    TrialCriteria c = criteria;
+    c.direction = d == "-x" ? -1.0 : 1.0;
+    CapacitySearch s = search;
+    if (directions.size() > 1 && !s.journal.empty()) s.journal += d == "-x" ? ".-x" : ".+x";
+    if (directions.size() > 1 && !common.quiet)
+      std::fprintf(stderr, "direction %s\n", d.c_str());
+    results.push_back(find_capacity(config, c, s));
+  }
+  std::size_t governing = 0;
+  for (std::size_t i = 1; i < results.size(); ++i)
+    if (results[i].lambda_star < results[governing].lambda_star) governing = i;
+
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    if (results.size() > 1) std::printf("direction %s:\n", directions[i].c_str());
+    print_capacity(results[i], opts);
+  }
+  if (results.size() > 1)
+    std::printf("governing direction %s: lambda* = %.4f\n", directions[governing].c_str(),
+                results[governing].lambda_star);
+  write_mode(results[governing], opts);
+
   if (!common.json_path.empty()) {
-    nlohmann::json runs = nlohmann::json::array();
-    for (const TrialResult& r : res.trials)
-      runs.push_back({{"lambda", r.lambda},
-                      {"collapsed", r.collapsed},
-                      {"reason", r.reason},
-                      {"sim_time", r.sim_time},
-                      {"steps", r.steps},
-                      {"wall_s", r.wall_s},
-                      {"max_displacement", r.max_displacement},
-                      {"max_rotation", r.max_rotation},
-                      {"energy_balance_error", r.energy_balance_error}});
-    nlohmann::json j = {{"lambda_star", res.lambda_star},
-                        {"bracket", {res.lo, res.hi}},
-                        {"bracketed", res.bracketed},
-                        {"tolerance", res.tolerance},
-                        {"runs", runs},
-                        {"triangles", res.triangles},
-                        {"dt", res.dt},
-                        {"wall_s", res.wall_s},
-                        {"points_per_round", opts.points},
-                        {"hinges", hinges_to_json(res.hinges)},
-                        {"resumed_trials", res.resumed_trials},
-                        {"seed",
-                         {{"used", res.seed.used},
-                          {"limit_status", res.seed.status},
-                          {"lambda_la", res.seed.used ? nlohmann::json(res.seed.lambda_la)
-                                                      : nlohmann::json(nullptr)},
-                          {"held", res.seed.held},
-                          {"widenings", res.seed.widenings},
-                          {"unseeded_trials_estimate", res.seed.unseeded_trials},
-                          {"trials_saved", res.seed.used ? res.seed.unseeded_trials -
-                                                               static_cast<int>(res.trials.size())
-                                                         : 0}}}};
+    nlohmann::json j = capacity_json(results[governing], opts);
+    j["direction"] = directions[governing];
+    j["quasi_static"] = criteria.quasi_static;
+    if (results.size() > 1) {
+      nlohmann::json each = nlohmann::json::object();
+      for (std::size_t i = 0; i < results.size(); ++i)
+        each[directions[i]] = capacity_json(results[i], opts);
+      j["directions"] = each;
+    }
     write_json(j, common.json_path);
   }
   return 0;

@@ -38,6 +38,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   std::vector<std::string> errors(cells);
   TrialCriteria criteria = opts.criteria;
   criteria.limits = common.limits;
+  criteria.quasi_static = !opts.dynamic;
   // Resume (drivers/journal.hpp): one record per finished cell ({"cell": i, "values": [...],
   // result}) under the fingerprint of the deck, overrides, axes and criteria; cells found
   // there are not run again.
@@ -50,6 +51,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   }
   print.value(opts.points);
   print.value(criteria.settle_max_time);
+  if (criteria.quasi_static) print.text("quasi-static");
   Journal journal(opts.resume, print.hex());
   std::vector<bool> finished(cells, false);
   for (const nlohmann::json& j : journal.records()) {

@@ -67,6 +67,8 @@ struct CapacityOptions {
   std::string mode_out;      // --mode-out FILE.json: deformed state of the collapse with hinges
   std::string picture;       // --picture FILE.png|svg: the same drawn by scripts/draw
   TrialCriteria criteria;    // --ramp-time, --rest-speed, ... (docs/capacity.md)
+  bool dynamic = false;      // --dynamic: no quasi-static damping (the physical trials)
+  std::string direction = "+x";  // --direction +x | -x | both
 };
 
 int command_capacity(const Config& config, const CommonOptions& common,
@@ -83,6 +85,7 @@ struct SweepOptions {
   std::string resume;                // --resume FILE: journal of finished cells
   int points = 2;
   TrialCriteria criteria;            // --settle-time (the other trial criteria: defaults)
+  bool dynamic = false;              // --dynamic, as for capacity
 };
 
 // Runs capacity over the grid; `deck_path` and `sets` rebuild the deck per cell.

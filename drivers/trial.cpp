@@ -262,6 +262,7 @@ void check_finite(const Simulation& sim, const std::string& label) {
       {"damping dissipation", l.damping_dissipated},
       {"friction dissipation", l.friction_dissipated},
       {"impact dissipation", l.impact_dissipated},
+      {"local damping dissipation", l.local_dissipated},
       {"peak energy", l.max_energy}};
   for (const auto& [name, e] : energies) {
     if (std::isfinite(e)) continue;

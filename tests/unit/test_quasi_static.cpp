@@ -1,0 +1,218 @@
+// Quasi-static decisions of `capacity` and `sweep` (issue 24, docs/capacity.md): Cundall's
+// local damping (core/integrate.hpp LocalDamping) against its closed form in free fall, its
+// energy booked so that the ledger still closes, a disturbed block brought to rest, the
+// analytic capacities of the block kept; the load direction (`capacity --direction`) against
+// mirror symmetry; bad keys and options refused.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/rigid.hpp"
+#include "drivers/capacity.hpp"
+#include "drivers/setup.hpp"
+#include "io/deck.hpp"
+#include "limit/limit_analysis.hpp"
+#include "subprocess.hpp"
+
+namespace voussoir {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A 0.25 x 1 m block on a fixed ground (scene "block"), rigid or elastic.
+std::string block_deck(const std::string& model, double mu = 0.8) {
+  return "[model]\nkind = \"block\"\nwidth = 0.25\nheight = 1.0\n[material]\nmodel = \"" + model +
+         "\"\n[contact]\nfriction = " + std::to_string(mu) + "\n";
+}
+
+Index free_block(const Model& m) {
+  for (Index b = 0; b < Index(m.blocks.size()); ++b)
+    if (!m.blocks[std::size_t(b)].fixed) return b;
+  return -1;
+}
+
+TEST(LocalDamping, ForceOpposesTheVelocityInProportionToTheForce) {
+  EXPECT_EQ(local_damping_force(0.8, 10.0, 1.0), -8.0);
+  EXPECT_EQ(local_damping_force(0.8, -10.0, 1.0), -8.0);
+  EXPECT_EQ(local_damping_force(0.8, 10.0, -1.0), 8.0);
+  EXPECT_EQ(local_damping_force(0.8, 10.0, 0.0), 0.0);
+  EXPECT_EQ(local_damping_force(0.8, 0.0, 3.0), 0.0);
+}
+
+// A body falling freely under a constant force mg: from the second step on, the damping force
+// is alpha m g against the motion, so the velocity gains (1 - alpha) g dt per step:
+//     v^(N+1/2) = -g dt - N (1 - alpha) g dt.
+// The dissipated energy is booked so that the ledger closes to round-off.
+void expect_damped_free_fall(const std::string& model) {
+  Simulation sim = make_simulation(parse_deck(block_deck(model), "test"));
+  const Index b = free_block(sim.model);
+  if (model == "rigid") {
+    set_rigid_state(sim.model, b, sim.model.rigid.cx0[b], sim.model.rigid.cy0[b] + 1.0, 0.0, 0.0,
+                    0.0, 0.0);
+  } else {
+    const Block& blk = sim.model.blocks[std::size_t(b)];
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i)
+      sim.model.nodes.y[i] += 1.0;
+  }
+  const double alpha = 0.8, g = 9.81, dt = sim.ctx.dt;
+  sim.ctx.local_damping = alpha;
+  const int steps = 200;  // far less than the 1 m drop
+  for (int k = 0; k < steps; ++k) advance(sim);
+  const double expected = -g * dt - (steps - 1) * (1.0 - alpha) * g * dt;
+  const Block& blk = sim.model.blocks[std::size_t(b)];
+  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+    // Elastic blocks: the element forces of the unstrained block are round-off (E x 1e-16).
+    const double tol = (model == "rigid" ? 1e-9 : 1e-8) * std::abs(expected);
+    EXPECT_NEAR(sim.model.nodes.vy[i], expected, tol) << model;
+    EXPECT_NEAR(sim.model.nodes.vx[i], 0.0, 1e-12) << model;
+  }
+  EXPECT_GT(sim.ledger.local_dissipated, 0.0);
+  // Of the work of gravity, the fraction alpha went into the damping (up to the first step).
+  EXPECT_NEAR(sim.ledger.local_dissipated / sim.ledger.external_work, alpha, 0.01) << model;
+  EXPECT_LT(sim.ledger.balance_error(), 1e-9) << model;
+}
+
+TEST(LocalDamping, RigidFreeFallAcceleratesAtOneMinusAlphaG) {
+  expect_damped_free_fall("rigid");
+}
+
+TEST(LocalDamping, ElasticFreeFallAcceleratesAtOneMinusAlphaG) {
+  expect_damped_free_fall("elastic");
+}
+
+// A rigid block tilted by 0.004 rad and held 0.2 mm above its joint at the lower corner, then
+// let go: without damping (restitution 1) it rocks and bounces on the joint springs for good;
+// with local damping it comes to rest within a few periods, and the ledger closes in both runs.
+TEST(LocalDamping, DisturbedBlockComesToRestAndTheLedgerCloses) {
+  double kinetic[2] = {0.0, 0.0};
+  for (int damped = 0; damped < 2; ++damped) {
+    Simulation sim = make_simulation(parse_deck(block_deck("rigid"), "test"));
+    const Index b = free_block(sim.model);
+    const double tilt = 0.004, half_width = 0.125;
+    set_rigid_state(sim.model, b, sim.model.rigid.cx0[b],
+                    sim.model.rigid.cy0[b] + half_width * tilt + 2e-4, tilt, 0.0, 0.0, 0.0);
+    sim.ctx.local_damping = damped ? 0.8 : 0.0;
+    double worst = 0.0;
+    while (sim.ctx.time < 0.3) {
+      advance(sim);
+      worst = std::max(worst, sim.ledger.balance_error());
+    }
+    kinetic[damped] = sim.ledger.kinetic;
+    EXPECT_LT(worst, 0.01) << "damped " << damped;
+    if (damped) {
+      EXPECT_GT(sim.ledger.local_dissipated, 0.0);
+    } else {
+      EXPECT_EQ(sim.ledger.local_dissipated, 0.0);
+    }
+  }
+  EXPECT_GT(kinetic[0], 0.0);
+  EXPECT_LT(kinetic[1], 1e-6 * kinetic[0]);
+}
+
+// The analytic capacities of the block (SPEC.md section 3: overturning at b / h, sliding at
+// mu) with quasi-static trials, rigid and elastic.
+TEST(QuasiStaticCapacity, BlockKeepsItsAnalyticCapacities) {
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  for (const char* model : {"rigid", "elastic"}) {
+    const CapacityResult over =
+        find_capacity(parse_deck(block_deck(model, 0.8), "test"), crit, 2, true);
+    ASSERT_TRUE(over.bracketed) << model;
+    EXPECT_NEAR(over.lambda_star, 0.25, 0.005 * 0.25 + 0.002) << model;
+    const CapacityResult slide =
+        find_capacity(parse_deck(block_deck(model, 0.2), "test"), crit, 2, true);
+    ASSERT_TRUE(slide.bracketed) << model;
+    EXPECT_NEAR(slide.lambda_star, 0.2, 0.005 * 0.2 + 0.002) << model;
+  }
+}
+
+// Three blocks on a fixed ground, the top one overhanging to the right: the structure has no
+// mirror symmetry, so its capacity towards -x differs from +x. Limit analysis towards -x must
+// equal limit analysis towards +x of the mirrored blocks, and the FDEM search likewise.
+std::string polygons(double sign) {
+  auto p = [sign](double x, double y) {
+    return std::to_string(sign * x) + " " + std::to_string(y) + "\n";
+  };
+  // Vertices counter-clockwise in both versions (the mirror reverses the order).
+  auto block = [&](std::vector<std::array<double, 2>> v) {
+    std::string s = "block\n";
+    if (sign < 0) std::reverse(v.begin(), v.end());
+    for (const auto& q : v) s += p(q[0], q[1]);
+    return s + "\n";
+  };
+  return block({{-0.3, 0.0}, {0.3, 0.0}, {0.3, 0.8}, {-0.3, 0.8}}) +
+         block({{-0.2, 0.8}, {0.3, 0.8}, {0.3, 1.4}, {-0.2, 1.4}}) +
+         block({{-0.1, 1.4}, {0.45, 1.4}, {0.45, 1.8}, {-0.1, 1.8}}) +
+         block({{-2.0, -0.3}, {2.0, -0.3}, {2.0, 0.0}, {-2.0, 0.0}});
+}
+
+Config polygon_deck(const fs::path& dir, double sign) {
+  const fs::path file = dir / (sign > 0 ? "stack.txt" : "stack_mirror.txt");
+  std::ofstream(file) << polygons(sign);
+  const std::string text = "[model]\nkind = \"polygons\"\nfile = \"" + file.string() +
+                           "\"\nfixed = [3]\n[material]\nmodel = \"rigid\"\n"
+                           "[contact]\nfriction = 0.8\n";
+  return parse_deck(text, (dir / "stack.toml").string());
+}
+
+TEST(Direction, MinusXIsPlusXOfTheMirroredStructure) {
+  const fs::path dir = fs::temp_directory_path() / "voussoir_direction_test";
+  fs::create_directories(dir);
+  const Config plain = polygon_deck(dir, 1.0), mirror = polygon_deck(dir, -1.0);
+  const Model m_plain = make_simulation(plain).model, m_mirror = make_simulation(mirror).model;
+
+  LimitOptions towards_minus;
+  towards_minus.direction = -1.0;
+  const LimitResult plus = limit_analysis(m_plain, 0.8, 9.81, false);
+  const LimitResult minus = limit_analysis(m_plain, 0.8, 9.81, false, towards_minus);
+  const LimitResult mirrored = limit_analysis(m_mirror, 0.8, 9.81, false);
+  ASSERT_EQ(plus.status, "optimal");
+  ASSERT_EQ(minus.status, "optimal");
+  EXPECT_NEAR(minus.lambda_la, mirrored.lambda_la, 1e-9 * mirrored.lambda_la);
+  // Not symmetric: the two directions differ by far more than the tolerances.
+  EXPECT_GT(std::abs(plus.lambda_la - minus.lambda_la), 0.05 * plus.lambda_la);
+
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  crit.direction = -1.0;
+  const CapacityResult fdem_minus = find_capacity(plain, crit, 2, true);
+  crit.direction = 1.0;
+  const CapacityResult fdem_mirror = find_capacity(mirror, crit, 2, true);
+  ASSERT_TRUE(fdem_minus.bracketed && fdem_mirror.bracketed);
+  // Both searches bracket the same threshold to the tolerance (0.5%).
+  EXPECT_NEAR(fdem_minus.lambda_star, fdem_mirror.lambda_star, 0.01 * fdem_mirror.lambda_star);
+  EXPECT_LT(fdem_minus.lambda_star, minus.lambda_la * 1.01);
+  fs::remove_all(dir);
+}
+
+TEST(QuasiStaticInput, BadDampingAndDirectionAreRefused) {
+  for (const char* v : {"1.0", "-0.1", "2"}) {
+    try {
+      parse_deck(block_deck("rigid"), "test", {std::string("capacity.local_damping=") + v});
+      FAIL() << v;
+    } catch (const DeckError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("capacity.local_damping"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(v), std::string::npos) << msg;
+    }
+  }
+  const fs::path dir = fs::temp_directory_path() / "voussoir_direction_bad";
+  fs::create_directories(dir);
+  const testing::ProcessResult r = testing::run_process(
+      {VOUSSOIR_BINARY, "capacity", std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml",
+       "--direction", "up"},
+      {}, (dir / "child").string());
+  ASSERT_TRUE(r.exited) << r.describe();
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--direction"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace voussoir
