@@ -57,12 +57,12 @@ inline void update_nodes(const NodeArrays& a, double dt, Index begin, Index end,
 
 // update_nodes with local damping: force f + d (integrate.hpp LocalDamping), d^(n-1) in
 // `previous` (2 per node); adds m v^- . v^+ into sums.x and the dissipated energy into sums.y.
-inline void update_nodes_damped(const NodeArrays& a, double dt, double alpha, double* previous,
-                                Index begin, Index end, Vec2& sums) {
+inline void update_nodes_damped(const NodeArrays& a, double dt, double alpha, bool outgoing,
+                                double* previous, Index begin, Index end, Vec2& sums) {
   double k2 = sums.x, work = sums.y;
   for (Index i = begin; i < end; ++i) {
-    const double dx = local_damping_force(alpha, a.fx[i], a.vx[i]);
-    const double dy = local_damping_force(alpha, a.fy[i], a.vy[i]);
+    const double dx = local_damping_force(alpha, outgoing, a.fx[i], a.vx[i]);
+    const double dy = local_damping_force(alpha, outgoing, a.fy[i], a.vy[i]);
     work -= 0.5 * dt * ((dx + previous[2 * i]) * a.vx[i] + (dy + previous[2 * i + 1]) * a.vy[i]);
     previous[2 * i] = dx;
     previous[2 * i + 1] = dy;
@@ -107,9 +107,10 @@ double integrate_central_difference(Model& model, double dt, LocalDamping& dampi
   previous.resize(2 * model.nodes.x.size(), 0.0);
   double* prev = previous.data();
   const double alpha = damping.alpha;
-  const Vec2 sums =
-      sum_over_free_nodes<Vec2>(model, [&a, dt, alpha, prev](Index begin, Index end, Vec2& s) {
-        update_nodes_damped(a, dt, alpha, prev, begin, end, s);
+  const bool outgoing = damping.outgoing;
+  const Vec2 sums = sum_over_free_nodes<Vec2>(
+      model, [&a, dt, alpha, outgoing, prev](Index begin, Index end, Vec2& s) {
+        update_nodes_damped(a, dt, alpha, outgoing, prev, begin, end, s);
       });
   damping.dissipated = sums.y;
   return 0.5 * sums.x;

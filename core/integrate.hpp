@@ -29,18 +29,24 @@ namespace voussoir {
 // unbalanced force f^n of the step gets a damping force
 //     d^n = -alpha |f^n| sign(v^(n-1/2)),
 // opposed to the motion and proportional to the force, not to the speed, so it damps every
-// mode alike whatever its frequency, and vanishes at equilibrium. The dissipated energy is the
-// trapezoidal work of the ledger (integrate.hpp header):
+// mode alike whatever its frequency, and vanishes at equilibrium. `outgoing` applies it only
+// while the force opposes the motion (f . v < 0: the degree of freedom moves away from its
+// equilibrium), where it equals alpha f: an oscillation still loses energy on every outgoing
+// half-swing, but a mechanism that the load accelerates (f . v > 0) is not slowed down at all,
+// where the full rule takes the fraction alpha of its driving force. The dissipated energy is
+// the trapezoidal work of the ledger (integrate.hpp header):
 //     D += -dt/2 (d^n + d^(n-1)) . v^(n-1/2)
 // exact with the leapfrog K^n, so the balance still closes.
 struct LocalDamping {
-  double alpha = 0.0;                 // coefficient, 0 <= alpha < 1
+  double alpha = 0.0;                       // coefficient, 0 <= alpha < 1
+  bool outgoing = true;                     // damp only while f . v < 0 (above)
   std::vector<double>* previous = nullptr;  // d^(n-1) per degree of freedom (sized on use)
-  double dissipated = 0.0;            // out: energy dissipated by this step [J]
+  double dissipated = 0.0;                  // out: energy dissipated by this step [J]
 };
 
 // The damping force of one degree of freedom (above).
-inline double local_damping_force(double alpha, double force, double velocity) {
+inline double local_damping_force(double alpha, bool outgoing, double force, double velocity) {
+  if (outgoing) return force * velocity < 0.0 ? alpha * force : 0.0;
   if (velocity > 0.0) return -alpha * std::abs(force);
   if (velocity < 0.0) return alpha * std::abs(force);
   return 0.0;

@@ -80,8 +80,8 @@ namespace {
 
 // The body update of integrate_rigid_bodies; `damping` (3 per body: x, y, rotation) when the
 // local damping is on (core/integrate.hpp LocalDamping), books its work into `dissipated`.
-double update_rigid_bodies(Model& model, double dt, double alpha, double* previous,
-                           double& dissipated) {
+double update_rigid_bodies(Model& model, double dt, double alpha, bool outgoing,
+                           double* previous, double& dissipated) {
   Nodes& n = model.nodes;
   RigidBodies& r = model.rigid;
   double twice_kinetic = 0.0;
@@ -101,9 +101,9 @@ double update_rigid_bodies(Model& model, double dt, double alpha, double* previo
     }
     if (previous) {
       double* d_prev = previous + 3 * b;
-      const double dx = local_damping_force(alpha, fx, r.vx[b]);
-      const double dy = local_damping_force(alpha, fy, r.vy[b]);
-      const double dr = local_damping_force(alpha, torque, r.omega[b]);
+      const double dx = local_damping_force(alpha, outgoing, fx, r.vx[b]);
+      const double dy = local_damping_force(alpha, outgoing, fy, r.vy[b]);
+      const double dr = local_damping_force(alpha, outgoing, torque, r.omega[b]);
       dissipated -= 0.5 * dt *
                     ((dx + d_prev[0]) * r.vx[b] + (dy + d_prev[1]) * r.vy[b] +
                      (dr + d_prev[2]) * r.omega[b]);
@@ -137,14 +137,14 @@ double update_rigid_bodies(Model& model, double dt, double alpha, double* previo
 
 double integrate_rigid_bodies(Model& model, double dt) {
   double unused = 0.0;
-  return update_rigid_bodies(model, dt, 0.0, nullptr, unused);
+  return update_rigid_bodies(model, dt, 0.0, false, nullptr, unused);
 }
 
 double integrate_rigid_bodies(Model& model, double dt, LocalDamping& damping) {
   damping.previous->resize(3 * model.blocks.size(), 0.0);
   damping.dissipated = 0.0;
-  return update_rigid_bodies(model, dt, damping.alpha, damping.previous->data(),
-                             damping.dissipated);
+  return update_rigid_bodies(model, dt, damping.alpha, damping.outgoing,
+                             damping.previous->data(), damping.dissipated);
 }
 
 }  // namespace voussoir

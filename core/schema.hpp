@@ -116,6 +116,9 @@ struct CapacityConfig {
   // Cundall's local damping coefficient of the quasi-static settle and trials of `capacity`
   // and `sweep` (docs/capacity.md "Quasi-static decisions"; `--dynamic`: none), in [0, 1)
   double local_damping = 0.8;
+  // "outgoing": only while the force opposes the motion (a mechanism is not slowed down);
+  // "full": Cundall's rule on every step (core/integrate.hpp LocalDamping)
+  std::string local_damping_mode = "outgoing";
 };
 
 struct OutputConfig {

@@ -128,7 +128,8 @@ void advance(Simulation& sim) {
   // 6. central difference: v then x (of the nodes, or of the rigid bodies and their nodes)
   double kinetic = 0.0;
   if (ctx.local_damping > 0.0) {
-    LocalDamping damping{ctx.local_damping, &sim.local_damping_previous};
+    LocalDamping damping{ctx.local_damping, ctx.local_damping_outgoing,
+                         &sim.local_damping_previous};
     kinetic = rigid ? integrate_rigid_bodies(model, ctx.dt, damping)
                     : integrate_central_difference(model, ctx.dt, damping);
     ledger.local_dissipated += damping.dissipated;

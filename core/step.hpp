@@ -33,6 +33,7 @@ struct StepContext {
   // Cundall's local damping coefficient alpha of the quasi-static phases (core/integrate.hpp
   // LocalDamping); 0 = off (every physical run)
   double local_damping = 0.0;
+  bool local_damping_outgoing = true;  // LocalDamping::outgoing
   // Body acceleration of the previous step, for the trapezoidal external work (core/loads.hpp);
   // set by advance(), not by drivers.
   double prev_body_ax = 0.0;

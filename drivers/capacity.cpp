@@ -31,7 +31,10 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   const auto t0 = Clock::now();
   SettledState s;
   s.sim = make_simulation(config);
-  if (crit.quasi_static) s.sim.ctx.local_damping = config.capacity.local_damping;
+  if (crit.quasi_static) {
+    s.sim.ctx.local_damping = config.capacity.local_damping;
+    s.sim.ctx.local_damping_outgoing = config.capacity.local_damping_mode == "outgoing";
+  }
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
   Simulation& sim = s.sim;
@@ -166,7 +169,10 @@ std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
   for (double v : {s.sim.ctx.dt, s.sim.ctx.eta, s.gravity, c.ramp_time, c.collapse_displacement,
                    c.collapse_rotation, c.rest_speed, c.hold_time, c.max_time})
     f.value(v);
-  if (s.sim.ctx.local_damping > 0.0) f.value(s.sim.ctx.local_damping);
+  if (s.sim.ctx.local_damping > 0.0) {
+    f.value(s.sim.ctx.local_damping);
+    f.value(s.sim.ctx.local_damping_outgoing ? 1.0 : 0.0);
+  }
   if (c.direction != 1.0) f.value(c.direction);
   return f.hex();
 }

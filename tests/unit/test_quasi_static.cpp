@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -39,18 +40,25 @@ Index free_block(const Model& m) {
 }
 
 TEST(LocalDamping, ForceOpposesTheVelocityInProportionToTheForce) {
-  EXPECT_EQ(local_damping_force(0.8, 10.0, 1.0), -8.0);
-  EXPECT_EQ(local_damping_force(0.8, -10.0, 1.0), -8.0);
-  EXPECT_EQ(local_damping_force(0.8, 10.0, -1.0), 8.0);
-  EXPECT_EQ(local_damping_force(0.8, 10.0, 0.0), 0.0);
-  EXPECT_EQ(local_damping_force(0.8, 0.0, 3.0), 0.0);
+  // Full rule: against the velocity, alpha |f|, whatever the sign of the force.
+  EXPECT_EQ(local_damping_force(0.8, false, 10.0, 1.0), -8.0);
+  EXPECT_EQ(local_damping_force(0.8, false, -10.0, 1.0), -8.0);
+  EXPECT_EQ(local_damping_force(0.8, false, 10.0, -1.0), 8.0);
+  EXPECT_EQ(local_damping_force(0.8, false, 10.0, 0.0), 0.0);
+  EXPECT_EQ(local_damping_force(0.8, false, 0.0, 3.0), 0.0);
+  // Outgoing rule: only when the force opposes the velocity, then alpha f.
+  EXPECT_EQ(local_damping_force(0.8, true, 10.0, 1.0), 0.0);
+  EXPECT_EQ(local_damping_force(0.8, true, -10.0, 1.0), -8.0);
+  EXPECT_EQ(local_damping_force(0.8, true, 10.0, -1.0), 8.0);
+  EXPECT_EQ(local_damping_force(0.8, true, 10.0, 0.0), 0.0);
 }
 
-// A body falling freely under a constant force mg: from the second step on, the damping force
-// is alpha m g against the motion, so the velocity gains (1 - alpha) g dt per step:
-//     v^(N+1/2) = -g dt - N (1 - alpha) g dt.
-// The dissipated energy is booked so that the ledger closes to round-off.
-void expect_damped_free_fall(const std::string& model) {
+// A body falling freely under a constant force mg. Full rule: from the second step on, the
+// damping force is alpha m g against the motion, so the velocity gains (1 - alpha) g dt per
+// step, v^(N+1/2) = -g dt - N (1 - alpha) g dt, and the ledger books the fraction alpha of
+// the work of gravity as dissipated. Outgoing rule: the force drives the motion, so nothing
+// is damped: v^(N+1/2) = -(N + 1) g dt, as without damping.
+void expect_damped_free_fall(const std::string& model, bool outgoing) {
   Simulation sim = make_simulation(parse_deck(block_deck(model), "test"));
   const Index b = free_block(sim.model);
   if (model == "rigid") {
@@ -63,9 +71,11 @@ void expect_damped_free_fall(const std::string& model) {
   }
   const double alpha = 0.8, g = 9.81, dt = sim.ctx.dt;
   sim.ctx.local_damping = alpha;
+  sim.ctx.local_damping_outgoing = outgoing;
   const int steps = 200;  // far less than the 1 m drop
   for (int k = 0; k < steps; ++k) advance(sim);
-  const double expected = -g * dt - (steps - 1) * (1.0 - alpha) * g * dt;
+  const double expected =
+      outgoing ? -steps * g * dt : -g * dt - (steps - 1) * (1.0 - alpha) * g * dt;
   const Block& blk = sim.model.blocks[std::size_t(b)];
   for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
     // Elastic blocks: the element forces of the unstrained block are round-off (E x 1e-16).
@@ -73,47 +83,55 @@ void expect_damped_free_fall(const std::string& model) {
     EXPECT_NEAR(sim.model.nodes.vy[i], expected, tol) << model;
     EXPECT_NEAR(sim.model.nodes.vx[i], 0.0, 1e-12) << model;
   }
-  EXPECT_GT(sim.ledger.local_dissipated, 0.0);
-  // Of the work of gravity, the fraction alpha went into the damping (up to the first step).
-  EXPECT_NEAR(sim.ledger.local_dissipated / sim.ledger.external_work, alpha, 0.01) << model;
+  if (outgoing) {
+    EXPECT_LT(std::abs(sim.ledger.local_dissipated), 1e-9 * sim.ledger.external_work) << model;
+  } else {
+    // Of the work of gravity, the fraction alpha went into the damping (up to the first step).
+    EXPECT_NEAR(sim.ledger.local_dissipated / sim.ledger.external_work, alpha, 0.01) << model;
+  }
   EXPECT_LT(sim.ledger.balance_error(), 1e-9) << model;
 }
 
-TEST(LocalDamping, RigidFreeFallAcceleratesAtOneMinusAlphaG) {
-  expect_damped_free_fall("rigid");
+TEST(LocalDamping, FullRuleFreeFallAcceleratesAtOneMinusAlphaG) {
+  expect_damped_free_fall("rigid", false);
+  expect_damped_free_fall("elastic", false);
 }
 
-TEST(LocalDamping, ElasticFreeFallAcceleratesAtOneMinusAlphaG) {
-  expect_damped_free_fall("elastic");
+TEST(LocalDamping, OutgoingRuleLeavesAnAcceleratingBodyAlone) {
+  expect_damped_free_fall("rigid", true);
+  expect_damped_free_fall("elastic", true);
 }
 
 // A rigid block tilted by 0.004 rad and held 0.2 mm above its joint at the lower corner, then
 // let go: without damping (restitution 1) it rocks and bounces on the joint springs for good;
 // with local damping it comes to rest within a few periods, and the ledger closes in both runs.
 TEST(LocalDamping, DisturbedBlockComesToRestAndTheLedgerCloses) {
-  double kinetic[2] = {0.0, 0.0};
-  for (int damped = 0; damped < 2; ++damped) {
-    Simulation sim = make_simulation(parse_deck(block_deck("rigid"), "test"));
-    const Index b = free_block(sim.model);
-    const double tilt = 0.004, half_width = 0.125;
-    set_rigid_state(sim.model, b, sim.model.rigid.cx0[b],
-                    sim.model.rigid.cy0[b] + half_width * tilt + 2e-4, tilt, 0.0, 0.0, 0.0);
-    sim.ctx.local_damping = damped ? 0.8 : 0.0;
-    double worst = 0.0;
-    while (sim.ctx.time < 0.3) {
-      advance(sim);
-      worst = std::max(worst, sim.ledger.balance_error());
+  for (bool outgoing : {false, true}) {
+    double kinetic[2] = {0.0, 0.0};
+    for (int damped = 0; damped < 2; ++damped) {
+      Simulation sim = make_simulation(parse_deck(block_deck("rigid"), "test"));
+      const Index b = free_block(sim.model);
+      const double tilt = 0.004, half_width = 0.125;
+      set_rigid_state(sim.model, b, sim.model.rigid.cx0[b],
+                      sim.model.rigid.cy0[b] + half_width * tilt + 2e-4, tilt, 0.0, 0.0, 0.0);
+      sim.ctx.local_damping = damped ? 0.8 : 0.0;
+      sim.ctx.local_damping_outgoing = outgoing;
+      double worst = 0.0;
+      while (sim.ctx.time < 0.3) {
+        advance(sim);
+        worst = std::max(worst, sim.ledger.balance_error());
+      }
+      kinetic[damped] = sim.ledger.kinetic;
+      EXPECT_LT(worst, 0.01) << "damped " << damped << " outgoing " << outgoing;
+      if (damped) {
+        EXPECT_GT(sim.ledger.local_dissipated, 0.0);
+      } else {
+        EXPECT_EQ(sim.ledger.local_dissipated, 0.0);
+      }
     }
-    kinetic[damped] = sim.ledger.kinetic;
-    EXPECT_LT(worst, 0.01) << "damped " << damped;
-    if (damped) {
-      EXPECT_GT(sim.ledger.local_dissipated, 0.0);
-    } else {
-      EXPECT_EQ(sim.ledger.local_dissipated, 0.0);
-    }
+    EXPECT_GT(kinetic[0], 0.0);
+    EXPECT_LT(kinetic[1], 1e-6 * kinetic[0]) << "outgoing " << outgoing;
   }
-  EXPECT_GT(kinetic[0], 0.0);
-  EXPECT_LT(kinetic[1], 1e-6 * kinetic[0]);
 }
 
 // The analytic capacities of the block (SPEC.md section 3: overturning at b / h, sliding at
@@ -189,6 +207,31 @@ TEST(Direction, MinusXIsPlusXOfTheMirroredStructure) {
   // Both searches bracket the same threshold to the tolerance (0.5%).
   EXPECT_NEAR(fdem_minus.lambda_star, fdem_mirror.lambda_star, 0.01 * fdem_mirror.lambda_star);
   EXPECT_LT(fdem_minus.lambda_star, minus.lambda_la * 1.01);
+  fs::remove_all(dir);
+}
+
+// `--direction both` on the symmetric block: two searches, each reported, equal to the
+// tolerance; the JSON carries both and the governing one at the top level.
+TEST(Direction, BothReportsEachDirectionAndTheSmaller) {
+  const fs::path dir = fs::temp_directory_path() / "voussoir_direction_both";
+  fs::create_directories(dir);
+  const std::string json = (dir / "cap.json").string();
+  const testing::ProcessResult r = testing::run_process(
+      {VOUSSOIR_BINARY, "capacity", std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml", "--set",
+       "material.model=rigid", "--direction", "both", "--quiet", "--json", json},
+      {}, (dir / "child").string());
+  ASSERT_TRUE(r.exited) << r.describe();
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("direction +x:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("direction -x:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("governing direction"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(json));
+  const double plus = j["directions"]["+x"]["lambda_star"];
+  const double minus = j["directions"]["-x"]["lambda_star"];
+  EXPECT_NEAR(plus, minus, 0.01 * plus);
+  EXPECT_EQ(double(j["lambda_star"]), std::min(plus, minus));
+  EXPECT_EQ(j["direction"], plus <= minus ? "+x" : "-x");
+  EXPECT_EQ(j["quasi_static"], true);
   fs::remove_all(dir);
 }
 
