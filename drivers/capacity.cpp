@@ -76,6 +76,19 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   return s;
 }
 
+Model mirror_x(const Model& model) {
+  Model m = model;
+  for (Block& b : m.blocks) {
+    for (Vec2& p : b.polygon) p.x = -p.x;
+    std::reverse(b.polygon.begin(), b.polygon.end());  // counter-clockwise again
+  }
+  for (Joint& j : m.joints) {
+    j.a.x = -j.a.x;
+    j.b.x = -j.b.x;
+  }
+  return m;
+}
+
 std::string unsettled_message(const SettledState& s, const TrialCriteria& crit) {
   char buf[320];
   if (s.collapsed)
@@ -320,10 +333,10 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     have_hi = round[0].collapsed;
     if (!have_hi) lo = hi;
   } else if (search.seed_from_limit) {
-    LimitOptions la_options;
-    la_options.direction = crit.direction;
-    const LimitResult la = limit_analysis(settled.sim.model, config.contact.friction,
-                                          settled.gravity, false, la_options);
+    // Towards -x: limit analysis of the mirror image towards +x.
+    const LimitResult la = limit_analysis(
+        crit.direction < 0.0 ? mirror_x(settled.sim.model) : settled.sim.model,
+        config.contact.friction, settled.gravity, false);
     res.seed.status = la.status;
     if (la.status == "optimal" && la.lambda_la > lo) {
       res.seed.used = true;

@@ -18,7 +18,10 @@
 //        a decaying oscillation, not a mechanism that has just started and is still slow);
 //      when neither happens by `max_time`, the trial is collapsed if the block motion is still
 //      growing (speed above the rest threshold), stable otherwise (reported as "timeout").
-// The thresholds are studied in docs/capacity.md.
+// The thresholds are studied in docs/capacity.md. With TrialCriteria::quasi_static (the
+// default of `capacity` and `sweep`) the settle and the trials run with the local damping of
+// the deck's capacity.local_damping (core/integrate.hpp LocalDamping; docs/capacity.md
+// "Quasi-static decisions"); TrialCriteria::direction points lambda g towards -x.
 //
 // Bisection: the bracket [lo, hi] (stable at lo, collapsed at hi) shrinks by k-section with
 // `points` trial lambdas per round (run in parallel on the available cores); the number of
@@ -83,6 +86,11 @@ struct SettledState {
 // rest rule), a collapse (their displacement or rotation rule: no gravity capacity), or
 // `settle_max_time`.
 SettledState settle(const Config& config, const TrialCriteria& criteria, bool quiet);
+
+// The block outlines and joints of `model` mirrored about x = 0 (outlines counter-clockwise):
+// what limit analysis reads, so that its lambda towards +x is the original's towards -x.
+// Nodes and triangles are copied unchanged.
+Model mirror_x(const Model& model);
 
 // Why a settle did not end at rest, for the error of the commands that need rest.
 std::string unsettled_message(const SettledState& settled, const TrialCriteria& criteria);

@@ -155,8 +155,8 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
     glp_set_row_bnds(P, r, GLP_FX, 0.0, 0.0);
     glp_set_row_bnds(P, r + 1, GLP_FX, w, w);
     glp_set_row_bnds(P, r + 2, GLP_FX, w * rc.x, w * rc.x);
-    put(r, 1, options.direction * w);
-    put(r + 2, 1, -options.direction * w * rc.y);
+    put(r, 1, w);
+    put(r + 2, 1, -w * rc.y);
   }
   if (gravity_only)
     glp_set_col_bnds(P, 1, GLP_FX, 0.0, 0.0);
@@ -253,7 +253,7 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
       ux[i] = glp_get_row_dual(P, first_row[i]);
       uy[i] = glp_get_row_dual(P, first_row[i] + 1);
       om[i] = glp_get_row_dual(P, first_row[i] + 2);
-      power += options.direction * area[i] / area_ref * (ux[i] - om[i] * scaled(centroid[i]).y);
+      power += area[i] / area_ref * (ux[i] - om[i] * scaled(centroid[i]).y);
     }
     const double sign = power < 0.0 ? -1.0 : 1.0;
     auto velocity = [&](Index i, Vec2 p) {

