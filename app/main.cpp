@@ -171,6 +171,8 @@ int main(int argc, char** argv) {
                         "folder for the block outlines of every collapsed cell (JSON)");
   stability->add_option("--ke-time", stab_opts.ke_time,
                         "time at which the kinetic energy is read [s] (default 1)");
+  stability->add_option("--resume", stab_opts.resume,
+                        "journal of finished cells: created, or resumed after a kill");
   stability->add_option("--max-time", stab_opts.max_time,
                         "simulated time after which undecided cells are decided [s] (default 3)");
 

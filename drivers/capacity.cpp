@@ -191,17 +191,13 @@ std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
 }
 
 nlohmann::json trial_json(const TrialResult& r) {
-  nlohmann::json hinges = nlohmann::json::array();
-  for (const Hinge& h : r.hinges)
-    hinges.push_back({h.joint, h.block_a, h.block_b, h.kind, h.side, h.position_deg, h.x, h.y,
-                      h.opening, h.slip});
   return {{"lambda", r.lambda},     {"collapsed", r.collapsed},
           {"reason", r.reason},     {"sim_time", r.sim_time},
           {"steps", r.steps},       {"wall_s", r.wall_s},
           {"max_displacement", r.max_displacement},
           {"max_rotation", r.max_rotation},
           {"energy_balance_error", r.energy_balance_error},
-          {"hinges", hinges}};
+          {"hinges", hinges_record(r.hinges)}};
 }
 
 TrialResult trial_from_json(const nlohmann::json& j) {
@@ -215,13 +211,7 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   r.max_displacement = j.at("max_displacement");
   r.max_rotation = j.at("max_rotation");
   r.energy_balance_error = j.at("energy_balance_error");
-  // NaN is written as null (a joint without an angular position).
-  auto num = [](const nlohmann::json& v) {
-    return v.is_null() ? std::numeric_limits<double>::quiet_NaN() : v.get<double>();
-  };
-  for (const auto& h : j.at("hinges"))
-    r.hinges.push_back(Hinge{h[0], h[1], h[2], h[3], h[4], num(h[5]), num(h[6]), num(h[7]),
-                             num(h[8]), num(h[9])});
+  r.hinges = hinges_from_record(j.at("hinges"));
   return r;
 }
 

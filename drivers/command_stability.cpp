@@ -11,6 +11,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "core/fnv.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plot.hpp"
 #include "drivers/stability.hpp"
@@ -26,16 +27,6 @@ nlohmann::json param_value(const std::string& s) {
   const double v = std::strtod(s.c_str(), &end);
   if (!s.empty() && end == s.c_str() + s.size() && std::isfinite(v)) return v;
   return s;
-}
-
-nlohmann::json polygons_json(const std::vector<std::vector<Vec2>>& polys) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& poly : polys) {
-    nlohmann::json p = nlohmann::json::array();
-    for (const Vec2& v : poly) p.push_back({v.x, v.y});
-    out.push_back(p);
-  }
-  return out;
 }
 
 std::string csv_quote(const std::string& s) {
@@ -66,8 +57,21 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
                  "undecided cells decided at %.3g s\n",
                  grid.configs.size(), crit.ke_time, crit.trial.max_time);
   const bool keep_modes = !opts.mode_out.empty();
-  const std::vector<StabilityCell> cells =
-      run_stability_map(grid, crit, common.threads, keep_modes, common.quiet);
+  // Resume (drivers/journal.hpp): one record per finished cell under the fingerprint of the
+  // deck, its overrides, the axes, the criteria and whether modes are kept.
+  Fnv print;
+  print.text(deck_path);
+  for (const std::string& set : sets) print.text(set);
+  for (const GridAxis& a : axes) {
+    print.text(a.key);
+    for (const std::string& v : a.values) print.text(v);
+  }
+  for (double v : {crit.ke_time, crit.trial.max_time, common.limits.drift_limit,
+                   double(common.limits.max_steps), keep_modes ? 1.0 : 0.0})
+    print.value(v);
+  Journal journal(opts.resume, print.hex());
+  const std::vector<StabilityCell> cells = run_stability_map(
+      grid, crit, common.threads, keep_modes, common.quiet, opts.resume.empty() ? nullptr : &journal);
 
   // CSV, written to a temporary name and renamed when complete.
   const std::string csv_path = opts.csv.empty() ? "stability.csv" : opts.csv;
@@ -148,8 +152,8 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
                   {"max_displacement", r.max_displacement},
                   {"max_rotation", r.max_rotation},
                   {"fixed", fixed},
-                  {"reference", polygons_json(r.outlines0)},
-                  {"deformed", polygons_json(r.outlines)},
+                  {"reference", outlines_record(r.outlines0)},
+                  {"deformed", outlines_record(r.outlines)},
                   {"hinges", hinges_to_json(r.hinges)}},
                  (std::filesystem::path(opts.mode_out) / name).string());
     }

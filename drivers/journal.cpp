@@ -3,10 +3,30 @@
 #include "drivers/journal.hpp"
 
 #include <fstream>
+#include <limits>
 
 #include "drivers/setup.hpp"
 
 namespace voussoir {
+
+nlohmann::json hinges_record(const std::vector<Hinge>& hinges) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Hinge& h : hinges)
+    out.push_back({h.joint, h.block_a, h.block_b, h.kind, h.side, h.position_deg, h.x, h.y,
+                   h.opening, h.slip});
+  return out;
+}
+
+std::vector<Hinge> hinges_from_record(const nlohmann::json& record) {
+  auto num = [](const nlohmann::json& v) {
+    return v.is_null() ? std::numeric_limits<double>::quiet_NaN() : v.get<double>();
+  };
+  std::vector<Hinge> out;
+  for (const auto& h : record)
+    out.push_back(Hinge{h[0], h[1], h[2], h[3], h[4], num(h[5]), num(h[6]), num(h[7]), num(h[8]),
+                        num(h[9])});
+  return out;
+}
 
 Journal::Journal(const std::string& path, const std::string& print) : path_(path) {
   if (path_.empty()) return;

@@ -10,7 +10,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drivers/kinematics.hpp"
+
 namespace voussoir {
+
+// The hinges of a record: one array [joint, block_a, block_b, kind, side, position_deg, x, y,
+// opening, slip] per hinge, NaN written as null (a joint without an angular position).
+nlohmann::json hinges_record(const std::vector<Hinge>& hinges);
+std::vector<Hinge> hinges_from_record(const nlohmann::json& record);
 
 class Journal {
  public:

@@ -130,9 +130,90 @@ void check_limit_admissibility(const Config& config, StabilityCell& cell) {
   }
 }
 
+nlohmann::json outlines_record(const std::vector<std::vector<Vec2>>& polys) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& poly : polys) {
+    nlohmann::json p = nlohmann::json::array();
+    for (const Vec2& v : poly) p.push_back({v.x, v.y});
+    out.push_back(p);
+  }
+  return out;
+}
+
+namespace {
+
+std::vector<std::vector<Vec2>> outlines_from_record(const nlohmann::json& j) {
+  std::vector<std::vector<Vec2>> out;
+  for (const auto& poly : j) {
+    out.emplace_back();
+    for (const auto& v : poly) out.back().push_back(Vec2{v[0], v[1]});
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json stability_cell_record(const StabilityCell& r) {
+  return {{"values", r.values},
+          {"thickness", r.thickness},
+          {"radius", r.radius},
+          {"friction", r.friction},
+          {"stable", r.stable},
+          {"reason", r.reason},
+          {"kinetic_energy", r.kinetic_energy},
+          {"normalised_ke", r.normalised_ke},
+          {"ke_read_time", r.ke_read_time},
+          {"ke_length", r.ke_length},
+          {"free_mass", r.free_mass},
+          {"max_displacement", r.max_displacement},
+          {"max_rotation", r.max_rotation},
+          {"decision_time", r.decision_time},
+          {"sim_time", r.sim_time},
+          {"steps", r.steps},
+          {"wall_s", r.wall_s},
+          {"triangles", r.triangles},
+          {"dt", r.dt},
+          {"l_ref", r.l_ref},
+          {"error", r.error},
+          {"hinges", hinges_record(r.hinges)},
+          {"outlines", outlines_record(r.outlines)},
+          {"outlines0", outlines_record(r.outlines0)},
+          {"fixed", r.fixed}};
+}
+
+StabilityCell stability_cell_from_record(const nlohmann::json& j) {
+  StabilityCell r;
+  r.values = j.at("values").get<std::vector<std::string>>();
+  r.thickness = j.at("thickness");
+  r.radius = j.at("radius");
+  r.friction = j.at("friction");
+  r.stable = j.at("stable");
+  r.reason = j.at("reason");
+  r.kinetic_energy = j.at("kinetic_energy");
+  r.normalised_ke = j.at("normalised_ke");
+  r.ke_read_time = j.at("ke_read_time");
+  r.ke_length = j.at("ke_length");
+  r.free_mass = j.at("free_mass");
+  r.max_displacement = j.at("max_displacement");
+  r.max_rotation = j.at("max_rotation");
+  r.decision_time = j.at("decision_time");
+  r.sim_time = j.at("sim_time");
+  r.steps = j.at("steps");
+  r.wall_s = j.at("wall_s");
+  r.triangles = j.at("triangles");
+  r.dt = j.at("dt");
+  r.l_ref = j.at("l_ref");
+  r.error = j.at("error");
+  r.hinges = hinges_from_record(j.at("hinges"));
+  r.outlines = outlines_from_record(j.at("outlines"));
+  r.outlines0 = outlines_from_record(j.at("outlines0"));
+  r.fixed = j.at("fixed").get<std::vector<bool>>();
+  return r;
+}
+
 std::vector<StabilityCell> run_stability_map(const Grid& grid,
                                              const StabilityCriteria& crit, int threads,
-                                             bool keep_modes, bool quiet) {
+                                             bool keep_modes, bool quiet, Journal* journal) {
   const long cells = static_cast<long>(grid.configs.size());
   // Limit-analysis cross-checks first, serially (a few ms each; GLPK is not assumed to be
   // thread-safe), so progress lines can flag disagreements.
@@ -140,11 +221,24 @@ std::vector<StabilityCell> run_stability_map(const Grid& grid,
   for (long c = 0; c < cells; ++c) check_limit_admissibility(grid.configs[c], la[c]);
 
   std::vector<StabilityCell> out(cells);
+  std::vector<char> finished(cells, 0);
+  if (journal)
+    for (const nlohmann::json& j : journal->records()) {
+      const long c = j.value("cell", -1L);
+      if (c < 0 || c >= cells || j.at("values") != nlohmann::json(grid.values[c]))
+        throw RunError("the stability journal belongs to another grid (cell " +
+                       std::to_string(c) + ")");
+      out[c] = stability_cell_from_record(j);
+      out[c].la_admissible = la[c].la_admissible;
+      out[c].la_status = la[c].la_status;
+      finished[c] = 1;
+    }
   const int nthreads = threads > 0 ? threads : omp_get_max_threads();
   const auto t0 = Clock::now();
   int done = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
   for (long c = 0; c < cells; ++c) {
+    if (finished[c]) continue;
     StabilityCell& r = out[c];
     try {
       std::string label;
@@ -168,6 +262,11 @@ std::vector<StabilityCell> run_stability_map(const Grid& grid,
     r.la_status = la[c].la_status;
 #pragma omp critical(stability_progress)
     {
+      if (journal) {
+        nlohmann::json record = stability_cell_record(r);
+        record["cell"] = c;
+        journal->append(record);
+      }
       ++done;
       if (!quiet) {
         std::fprintf(stderr, "[%d/%ld]", done, cells);

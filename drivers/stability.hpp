@@ -40,6 +40,7 @@
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/grid.hpp"
+#include "drivers/journal.hpp"
 #include "drivers/kinematics.hpp"
 #include "core/schema.hpp"
 
@@ -99,9 +100,19 @@ void check_limit_admissibility(const Config& config, StabilityCell& cell);
 // default), then the limit-analysis cross-checks. `keep_modes` keeps the outlines of
 // collapsed cells. Progress lines on stderr unless quiet. A failing cell is reported in its
 // `error`, the others still run.
+// With a `journal` (drivers/journal.hpp; `stability --resume FILE`), cells found there are
+// taken from it, bit for bit, and each cell run is appended as it finishes.
 std::vector<StabilityCell> run_stability_map(const Grid& grid,
                                              const StabilityCriteria& criteria, int threads,
-                                             bool keep_modes, bool quiet);
+                                             bool keep_modes, bool quiet,
+                                             Journal* journal = nullptr);
+
+// Block outlines as JSON: one array of [x, y] per block (journal records and --mode-out).
+nlohmann::json outlines_record(const std::vector<std::vector<Vec2>>& outlines);
+
+// A cell as a journal record and back (every field, 17 significant digits).
+nlohmann::json stability_cell_record(const StabilityCell& cell);
+StabilityCell stability_cell_from_record(const nlohmann::json& record);
 
 struct StabilityOptions {
   std::vector<std::string> params;  // --param KEY=V1,V2,... or KEY=start:stop:step
@@ -110,6 +121,7 @@ struct StabilityOptions {
   std::string mode_out;             // --mode-out DIR: outlines of every collapsed cell
   double ke_time = 1.0;             // --ke-time [s]
   double max_time = 3.0;            // --max-time [s]
+  std::string resume;               // --resume FILE: journal of finished cells
 };
 
 int command_stability(const std::string& deck_path, const std::vector<std::string>& sets,

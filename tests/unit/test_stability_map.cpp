@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -65,10 +66,9 @@ TEST(StabilityRange, ExpandsWithoutFloatingDrift) {
 TEST(Grid, ThicknessRatioScalesWithRadius) {
   std::vector<std::string> sets = kCoarse;
   sets.push_back("model.radius=10");
-  const Grid g =
-      make_grid(kDeck, sets,
-                          {parse_grid_param("contact.friction=0.3,0.7"),
-                           parse_grid_param("model.thickness_ratio=0.05,0.13")});
+  const Grid g = make_grid(kDeck, sets,
+                           {parse_grid_param("contact.friction=0.3,0.7"),
+                            parse_grid_param("model.thickness_ratio=0.05,0.13")});
   ASSERT_EQ(g.configs.size(), 4u);
   // Row-major, last axis fastest.
   EXPECT_EQ(g.values[1], (std::vector<std::string>{"0.3", "0.13"}));
@@ -121,10 +121,9 @@ TEST(StabilityCell, ThickArchStandsThinArchFalls) {
 }
 
 TEST(StabilityMap, SameResultsOnOneAndTwoThreads) {
-  const Grid g =
-      make_grid(kDeck, kCoarse,
-                          {parse_grid_param("model.thickness_ratio=0.05,0.25"),
-                           parse_grid_param("contact.friction=0.6,0.8")});
+  const Grid g = make_grid(kDeck, kCoarse,
+                           {parse_grid_param("model.thickness_ratio=0.05,0.25"),
+                            parse_grid_param("contact.friction=0.6,0.8")});
   const StabilityCriteria crit = fast_criteria();
   const std::vector<StabilityCell> one = run_stability_map(g, crit, 1, false, true);
   const std::vector<StabilityCell> two = run_stability_map(g, crit, 2, false, true);
@@ -143,6 +142,43 @@ TEST(StabilityMap, SameResultsOnOneAndTwoThreads) {
     EXPECT_EQ(two[c].max_displacement, one[c].max_displacement) << c;
     EXPECT_EQ(two[c].values, g.values[c]);
   }
+}
+
+// `stability --resume`: a map killed after its first cell, run again with the same journal,
+// takes that cell from the journal and runs only the others; every cell, the collapse-mode
+// outlines included, equals the uninterrupted map's bit for bit (but the wall time of the cell
+// run again). A journal of another grid is
+// refused.
+TEST(StabilityMap, ResumedMapEqualsTheUninterruptedOne) {
+  const Grid g = make_grid(kDeck, kCoarse, {parse_grid_param("model.thickness_ratio=0.05,0.25")});
+  const StabilityCriteria crit = fast_criteria();
+  const std::vector<StabilityCell> straight = run_stability_map(g, crit, 1, true, true);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "voussoir_stability_resume.journal").string();
+  std::filesystem::remove(path);
+  {
+    Journal first(path, "test-print");
+    nlohmann::json record = stability_cell_record(straight[0]);
+    record["cell"] = 0;
+    first.append(record);  // the kill came after cell 0
+  }
+  Journal journal(path, "test-print");
+  ASSERT_EQ(journal.records().size(), 1u);
+  const std::vector<StabilityCell> resumed = run_stability_map(g, crit, 1, true, true, &journal);
+  ASSERT_EQ(resumed.size(), 2u);
+  for (size_t c = 0; c < 2; ++c) {
+    nlohmann::json a = stability_cell_record(resumed[c]), b = stability_cell_record(straight[c]);
+    if (c == 1) a.erase("wall_s"), b.erase("wall_s");  // run again: its own wall time
+    EXPECT_EQ(a, b) << c;
+    EXPECT_EQ(resumed[c].la_admissible, straight[c].la_admissible) << c;
+  }
+  EXPECT_FALSE(resumed[0].outlines.empty());  // the collapsed thin arch keeps its mode
+  EXPECT_EQ(Journal(path, "test-print").records().size(), 2u);  // cell 1 was appended
+
+  const Grid other =
+      make_grid(kDeck, kCoarse, {parse_grid_param("model.thickness_ratio=0.06,0.25")});
+  EXPECT_THROW(run_stability_map(other, crit, 1, true, true, &journal), RunError);
+  std::filesystem::remove(path);
 }
 
 }  // namespace
