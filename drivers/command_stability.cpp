@@ -20,14 +20,6 @@
 namespace voussoir {
 namespace {
 
-// A parameter value as JSON: a number when the text is one, else the text.
-nlohmann::json param_value(const std::string& s) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (!s.empty() && end == s.c_str() + s.size() && std::isfinite(v)) return v;
-  return s;
-}
-
 nlohmann::json polygons_json(const std::vector<std::vector<Vec2>>& polys) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& poly : polys) {
@@ -36,12 +28,6 @@ nlohmann::json polygons_json(const std::vector<std::vector<Vec2>>& polys) {
     out.push_back(p);
   }
   return out;
-}
-
-std::string csv_quote(const std::string& s) {
-  std::string q = "\"";
-  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-  return q + "\"";
 }
 
 }  // namespace
