@@ -8,8 +8,8 @@
 //   - the defaults: a default-constructed Config (core/schema.hpp), printed per key;
 //   - which kinds need a key: the scene-kind registry (core/scene_kinds.hpp);
 //   - the meaning: one line per key in io/deck_reference.cpp, the only hand-written column.
-// tests/unit/test_deck_reference.cpp fails naming any key the reader accepts without a line
-// there, and when docs/deck.md differs from `voussoir keys`.
+// The DeckReference tests (tests/unit/test_tools.cpp) fail naming any key the reader accepts
+// without a line there, and when docs/deck.md differs from `voussoir keys`.
 
 #include <string>
 #include <vector>

@@ -30,7 +30,8 @@
 // magnify); `velocity` is a 3-component point vector; stress is five named cell scalars. Data
 // items name the .h5 by its file name, resolved by the readers against the folder of the
 // .xdmf, so the pair opens from any working directory and can be moved together. Checked with
-// ParaView 5.11's XDMF Reader and Xdmf3ReaderS/T (tests/slow/paraview_open.py).
+// ParaView 5.11's XDMF Reader and Xdmf3ReaderS/T (tests/python/paraview_open.py) and with
+// h5py (tests/python/xdmf_h5.py).
 //
 // Completeness contract (SPEC.md: "no partial file left looking complete"):
 //   - open() removes any earlier `path` and its .xdmf, and writes to `path + ".tmp"` with
