@@ -19,6 +19,8 @@
 
 #include "io/deck.hpp"
 #include "io/deck_reference.hpp"
+#include "mesh/geometry.hpp"
+#include "mesh/scene.hpp"
 #include "subprocess.hpp"
 
 namespace {
@@ -120,6 +122,40 @@ TEST(GmshWall, SlidesAtMu) {
   EXPECT_NEAR(c.at("lambda_star").get<double>(), mu, tolerance * hi) << c.dump();
   EXPECT_EQ(c.at("failure_mode"), "sliding") << c.at("hinges").dump();
   EXPECT_LT(lo, hi);
+}
+
+TEST(Joints, PointsAlongASideAreMergedBeforeTheJointSearch) {
+  // A ground and two blocks side by side, every side drawn with points along it (as a mesh
+  // boundary has): one joint per interface, spanning it, as with the corners alone.
+  const fs::path dir = scratch("merge");
+  auto write_and_build = [&](const std::string& name, const std::string& blocks) {
+    std::ofstream(dir / name) << blocks;
+    voussoir::Config c =
+        voussoir::parse_deck("[model]\nkind = \"polygons\"\nfile = \"" + name + "\"\nfixed = [0]\n",
+                             "deck.toml", {}, dir.string());
+    return voussoir::build_model(voussoir::scene_params(c));
+  };
+  const voussoir::Model corners = write_and_build(
+      "corners.txt",
+      "-1 -0.2\n1 -0.2\n1 0\n-1 0\n\n-0.5 0\n0 0\n0 1\n-0.5 1\n\n0 0\n0.5 0\n0.5 1\n0 1\n");
+  const voussoir::Model dense =
+      write_and_build("dense.txt",
+                      "-1 -0.2\n1 -0.2\n1 0\n0.75 0\n0.25 0\n-0.25 0\n-0.75 0\n-1 0\n\n"
+                      "-0.5 0\n-0.25 0\n0 0\n0 0.3\n0 0.6\n0 1\n-0.5 1\n\n"
+                      "0 0\n0.5 0\n0.5 0.5\n0.5 1\n0 1\n0 0.5\n");
+  ASSERT_EQ(corners.joints.size(), 3u);
+  ASSERT_EQ(dense.joints.size(), corners.joints.size());
+  for (std::size_t k = 0; k < dense.joints.size(); ++k) {
+    EXPECT_EQ(dense.joints[k].block_a, corners.joints[k].block_a) << k;
+    EXPECT_EQ(dense.joints[k].block_b, corners.joints[k].block_b) << k;
+    EXPECT_NEAR(voussoir::distance(dense.joints[k].a, corners.joints[k].a), 0.0, 1e-12) << k;
+    EXPECT_NEAR(voussoir::distance(dense.joints[k].b, corners.joints[k].b), 0.0, 1e-12) << k;
+  }
+  // A side that bends (a polygon's real corner, however shallow) is kept.
+  const std::vector<voussoir::Vec2> bent = {{0, 0}, {1, 0}, {2, 1e-6}, {2, 1}, {0, 1}};
+  EXPECT_EQ(voussoir::merge_collinear(bent).size(), 5u);
+  const std::vector<voussoir::Vec2> straight = {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {1, 1}, {0, 1}};
+  EXPECT_EQ(voussoir::merge_collinear(straight).size(), 4u);
 }
 
 TEST(Check, RefusesModelsThatCannotRun) {
