@@ -28,7 +28,7 @@ nlohmann::json model_geometry_json(const Model& model) {
   for (const Block& b : model.blocks) {
     json poly = json::array();
     for (const Vec2& p : b.polygon) poly.push_back({p.x, p.y});
-    blocks.push_back({{"fixed", b.fixed}, {"role", b.role}, {"polygon", poly}});
+    blocks.push_back({{"fixed", b.fixed}, {"role", b.role}, {"name", b.name}, {"polygon", poly}});
   }
   json joints = json::array();
   for (const Joint& j : model.joints)

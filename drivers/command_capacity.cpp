@@ -30,8 +30,11 @@ nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
 
 std::string joint_list(const std::vector<Hinge>& hinges, const std::string& kind) {
   std::string out;
-  for (const Hinge& h : hinges)
-    if (h.kind == kind) out += (out.empty() ? "" : " ") + std::to_string(h.joint);
+  for (const Hinge& h : hinges) {
+    if (h.kind != kind) continue;
+    if (!out.empty()) out += ' ';
+    out += std::to_string(h.joint);
+  }
   return out;
 }
 

@@ -27,7 +27,7 @@ struct CheckOptions {
 };
 
 // The meshed model as JSON for scripts/draw: nodes (current positions), triangles, tri_block,
-// blocks (fixed, role, polygon), joints.
+// blocks (fixed, role, name: the gmsh physical name or "", polygon), joints.
 nlohmann::json model_geometry_json(const Model& model);
 
 // The deformed model for pictures of a failure mode: model_geometry_json of the current state
