@@ -25,6 +25,7 @@ def main():
     ap.add_argument("--scale", type=float, default=1.0, help="Warp By Vector scale factor")
     a = ap.parse_args()
     work = os.path.abspath(a.work)
+    picture = os.path.abspath(a.picture) if a.picture else ""  # before the chdir below
     os.makedirs(os.path.join(work, "elsewhere"), exist_ok=True)
     sets = a.set if a.set is not None else ["load.lambda=0.3", "contact.friction=0.2",
                                             "solver.end_time=0.05", "output.every=0.01"]
@@ -94,7 +95,7 @@ def main():
                                view.CameraFocalPoint[2] + 10.0]
         view.CameraViewUp = [0, 1, 0]
         view.ResetCamera()
-        png = a.picture if (a.picture and name == "Xdmf3ReaderS") else os.path.join(
+        png = picture if (picture and name == "Xdmf3ReaderS") else os.path.join(
             work, f"{name}.png")
         SaveScreenshot(png, view, ImageResolution=[1200, 700])
         check(os.path.getsize(png) > 1000, f"{name}: screenshot {png}")
