@@ -16,6 +16,7 @@
 #include "drivers/setup.hpp"
 #include "drivers/stability.hpp"
 #include "io/deck.hpp"
+#include "io/deck_reference.hpp"
 #include "voussoir/config.hpp"
 
 namespace {
@@ -176,6 +177,10 @@ int main(int argc, char** argv) {
   stability->add_option("--max-time", stab_opts.max_time,
                         "simulated time after which undecided cells are decided [s] (default 3)");
 
+  CLI::App* keys = app.add_subcommand(
+      "keys", "print the deck reference: every key, type, unit, default, allowed values "
+              "(docs/deck.md)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -184,6 +189,10 @@ int main(int argc, char** argv) {
   }
 
   try {
+    if (keys->parsed()) {
+      std::fputs(voussoir::deck_reference_markdown().c_str(), stdout);
+      return 0;
+    }
     if (common.threads > 0) omp_set_num_threads(common.threads);
     if (sweep->parsed())
       return voussoir::command_sweep(deck.deck, deck.sets, common, sweep_opts);

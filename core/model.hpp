@@ -103,6 +103,7 @@ struct Triangles {
 struct Block {
   bool fixed = false;
   std::string role;                  // "voussoir", "abutment", "buttress", "ground", ...
+  std::string name;                  // name in the source file (gmsh physical), or empty
   std::vector<Vec2> polygon;         // outline, counter-clockwise [m]
   Index first_node = 0, node_count = 0;
   Index first_tri = 0, tri_count = 0;

@@ -28,7 +28,7 @@ nlohmann::json model_geometry_json(const Model& model) {
   for (const Block& b : model.blocks) {
     json poly = json::array();
     for (const Vec2& p : b.polygon) poly.push_back({p.x, p.y});
-    blocks.push_back({{"fixed", b.fixed}, {"role", b.role}, {"polygon", poly}});
+    blocks.push_back({{"fixed", b.fixed}, {"role", b.role}, {"name", b.name}, {"polygon", poly}});
   }
   json joints = json::array();
   for (const Joint& j : model.joints)
@@ -78,6 +78,14 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   std::printf("model       %s\n", m.kind.c_str());
   std::printf("blocks      %zu (%d free, %zu fixed)\n", m.blocks.size(), free_blocks,
               m.blocks.size() - free_blocks);
+  // Blocks read from a gmsh file: which physical surface became which block index (the
+  // numbers model.fixed takes).
+  bool named = false;
+  for (const Block& b : m.blocks) named = named || !b.name.empty();
+  if (named)
+    for (std::size_t b = 0; b < m.blocks.size(); ++b)
+      std::printf("  block %-4zu %-5s \"%s\"\n", b, m.blocks[b].fixed ? "fixed" : "free",
+                  m.blocks[b].name.c_str());
   std::printf("triangles   %d\n", m.tris.size());
   std::printf("nodes       %d\n", m.nodes.size());
   std::printf("free area   %.6g m2\n", free_area(m));
@@ -122,6 +130,11 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                         {"joints", m.joints.size()},
                         {"block_model", info.rigid ? "rigid" : "elastic"},
                         {"dt_set_by", info.dt_set_by}};
+    if (named) {
+      nlohmann::json names = nlohmann::json::array();
+      for (const Block& b : m.blocks) names.push_back(b.name);
+      j["block_names"] = names;
+    }
     write_json(j, common.json_path);
   }
   if (!opts.mesh_out.empty()) write_json(model_geometry_json(m), opts.mesh_out);

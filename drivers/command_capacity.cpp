@@ -30,12 +30,37 @@ nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges) {
   return out;
 }
 
+std::string joint_list(const std::vector<Hinge>& hinges, const std::string& kind) {
+  std::string out;
+  for (const Hinge& h : hinges) {
+    if (h.kind != kind) continue;
+    if (!out.empty()) out += ' ';
+    out += std::to_string(h.joint);
+  }
+  return out;
+}
+
+std::string failure_mode_text(const CapacityResult& r) {
+  if (!r.bracketed) return kNoCollapse;
+  const bool hinging = !joint_list(r.hinges, "hinge").empty();
+  const bool sliding = !joint_list(r.hinges, "sliding").empty();
+  if (hinging && sliding) return "hinging and sliding";
+  if (hinging) return "hinging";
+  if (sliding) return "sliding";
+  return "none found";
+}
+
 namespace {
 
 // The text report of one search: lambda*, the seed, and the hinges of the failure mode.
 void print_capacity(const CapacityResult& res, const CapacityOptions& opts) {
-  std::printf("lambda* = %.4f  bracket [%.4f, %.4f]  %zu trials  %.1f s wall\n", res.lambda_star,
-              res.lo, res.hi, res.trials.size(), res.wall_s);
+  // No collapse: no lambda*, only the highest lambda that stood.
+  if (res.bracketed)
+    std::printf("lambda* = %.4f  bracket [%.4f, %.4f]  %zu trials  %.1f s wall\n",
+                res.lambda_star, res.lo, res.hi, res.trials.size(), res.wall_s);
+  else
+    std::printf("%s = %.4f (every trial stood)  %zu trials  %.1f s wall\n", kNoCollapse, res.lo,
+                res.trials.size(), res.wall_s);
   if (res.seed.used)
     std::printf("seeded from limit analysis lambda_la = %.4f: %s, %d trials against about %d "
                 "unseeded\n",
@@ -43,8 +68,7 @@ void print_capacity(const CapacityResult& res, const CapacityOptions& opts) {
                 static_cast<int>(res.trials.size()), res.seed.unseeded_trials);
   if (res.resumed_trials > 0)
     std::printf("%d trials taken from the journal %s\n", res.resumed_trials, opts.resume.c_str());
-  if (!res.bracketed)
-    std::printf("no collapse found up to lambda = 8: lambda* is at least %.4f\n", res.lo);
+  if (res.bracketed) std::printf("failure mode: %s\n", failure_mode_text(res).c_str());
   for (const Hinge& h : res.hinges) {
     std::printf("  %-7s joint %d (blocks %d-%d)", h.kind.c_str(), h.joint, h.block_a, h.block_b);
     // Joints off the arch centreline (a buttress on its ground) have no angular position.
@@ -67,9 +91,13 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
                     {"max_displacement", r.max_displacement},
                     {"max_rotation", r.max_rotation},
                     {"energy_balance_error", r.energy_balance_error}});
-  return {{"lambda_star", res.lambda_star},
-          {"bracket", {res.lo, res.hi}},
+  const nlohmann::json none(nullptr);
+  nlohmann::json j = {
+          {"lambda_star", res.bracketed ? nlohmann::json(res.lambda_star) : none},
+          {"bracket", {res.lo, res.bracketed ? nlohmann::json(res.hi) : none}},
           {"bracketed", res.bracketed},
+          {"result", res.bracketed ? "collapse" : kNoCollapse},
+          {"failure_mode", failure_mode_text(res)},
           {"tolerance", res.tolerance},
           {"runs", runs},
           {"triangles", res.triangles},
@@ -89,6 +117,9 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
             {"trials_saved", res.seed.used ? res.seed.unseeded_trials -
                                                  static_cast<int>(res.trials.size())
                                            : 0}}}};
+  // The highest lambda tried, which stood: the lambda_max of "no collapse up to lambda_max".
+  if (!res.bracketed) j["lambda_max"] = res.lo;
+  return j;
 }
 
 // The failure-mode JSON and picture of the governing search.

@@ -19,23 +19,6 @@
 #include "io/json.hpp"
 
 namespace voussoir {
-namespace {
-
-// A parameter value as JSON: a number when the text is one, else the text.
-nlohmann::json param_value(const std::string& s) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (!s.empty() && end == s.c_str() + s.size() && std::isfinite(v)) return v;
-  return s;
-}
-
-std::string csv_quote(const std::string& s) {
-  std::string q = "\"";
-  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-  return q + "\"";
-}
-
-}  // namespace
 
 int command_stability(const std::string& deck_path, const std::vector<std::string>& sets,
                       const CommonOptions& common, const StabilityOptions& opts) {

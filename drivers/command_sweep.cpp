@@ -21,6 +21,17 @@
 #include "io/json.hpp"
 
 namespace voussoir {
+namespace {
+
+// The joint indices of the hinges of one kind, as a JSON array.
+nlohmann::json joint_indices(const std::vector<Hinge>& hinges, const std::string& kind) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Hinge& h : hinges)
+    if (h.kind == kind) out.push_back(h.joint);
+  return out;
+}
+
+}  // namespace
 
 int command_sweep(const std::string& deck_path, const std::vector<std::string>& sets,
                   const CommonOptions& common, const SweepOptions& opts) {
@@ -66,6 +77,14 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
     r.bracketed = j["bracketed"];
     r.trials.resize(j["trials"].get<size_t>());
     r.wall_s = j["wall_s"];
+    // The failure mode's joints (only their kind and index are tabulated).
+    for (const char* kind : {"hinge", "sliding"})
+      for (const nlohmann::json& jt : j.value(std::string(kind) + "_joints", nlohmann::json::array())) {
+        Hinge h;
+        h.kind = kind;
+        h.joint = jt.get<int>();
+        r.hinges.push_back(h);
+      }
     errors[c] = j["error"];
     finished[c] = true;
   }
@@ -89,17 +108,22 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
                       {"bracketed", r.bracketed},
                       {"trials", r.trials.size()},
                       {"wall_s", r.wall_s},
+                      {"hinge_joints", joint_indices(r.hinges, "hinge")},
+                      {"sliding_joints", joint_indices(r.hinges, "sliding")},
                       {"error", errors[c]}});
       ++done;
       if (!common.quiet) {
         std::fprintf(stderr, "[%d/%zu]", done, cells);
         for (size_t k = 0; k < axes.size(); ++k)
           std::fprintf(stderr, " %s=%s", axes[k].key.c_str(), cell_values[c][k].c_str());
-        if (errors[c].empty())
-          std::fprintf(stderr, "  lambda* = %.4f (%zu trials, %.1f s)\n", results[c].lambda_star,
-                       results[c].trials.size(), results[c].wall_s);
-        else
+        if (!errors[c].empty())
           std::fprintf(stderr, "  failed: %s\n", errors[c].c_str());
+        else if (!r.bracketed)
+          std::fprintf(stderr, "  %s = %.4f (%zu trials, %.1f s)\n", kNoCollapse, r.lo,
+                       r.trials.size(), r.wall_s);
+        else
+          std::fprintf(stderr, "  lambda* = %.4f, %s (%zu trials, %.1f s)\n", r.lambda_star,
+                       failure_mode_text(r).c_str(), r.trials.size(), r.wall_s);
       }
     }
   }
@@ -109,22 +133,38 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   csv.precision(17);
   if (!csv) throw OutputError("cannot write " + csv_path);
   for (const GridAxis& a : axes) csv << a.key << ',';
-  // The CSV holds results only (no wall times), so a resumed sweep writes the same file as an
-  // uninterrupted one; wall times are in the JSON and on stderr.
-  csv << "lambda_star,lo,hi,bracketed,trials,error\n";
+  // One row per cell: the swept values, the result and its failure mode (hinge_joints and
+  // sliding_joints: joint indices of check --mesh-out, space separated), the trials and the
+  // cell's wall time. A cell taken from a --resume journal keeps its journalled wall time, so
+  // a resumed sweep differs from an uninterrupted one in the wall_s of the cells it re-ran
+  // only. lambda_star is empty when no trial collapsed (failure_mode says kNoCollapse; lo is
+  // then the highest lambda that stood) or the cell failed (error).
+  csv << "lambda_star,lo,hi,bracketed,failure_mode,hinge_joints,sliding_joints,trials,wall_s,"
+         "error\n";
   nlohmann::json jcells = nlohmann::json::array();
+  const nlohmann::json none(nullptr);
   for (size_t c = 0; c < cells; ++c) {
     const CapacityResult& r = results[c];
+    const bool ok = errors[c].empty();
     nlohmann::json params = nlohmann::json::object();
     for (size_t k = 0; k < axes.size(); ++k) {
       csv << cell_values[c][k] << ',';
-      params[axes[k].key] = cell_values[c][k];
+      params[axes[k].key] = param_value(cell_values[c][k]);
     }
-    csv << r.lambda_star << ',' << r.lo << ',' << r.hi << ',' << (r.bracketed ? 1 : 0) << ','
-        << r.trials.size() << ',' << '"' << errors[c] << '"' << '\n';
+    const std::string mode = ok ? failure_mode_text(r) : std::string();
+    if (ok && r.bracketed) csv << r.lambda_star;
+    csv << ',' << r.lo << ',';
+    if (r.bracketed) csv << r.hi;
+    csv << ',' << (r.bracketed ? 1 : 0) << ',' << mode << ','
+        << joint_list(r.hinges, "hinge") << ',' << joint_list(r.hinges, "sliding") << ','
+        << r.trials.size() << ',' << r.wall_s << ',' << csv_quote(errors[c]) << '\n';
     jcells.push_back({{"params", params},
-                      {"lambda_star", r.lambda_star},
-                      {"bracket", {r.lo, r.hi}},
+                      {"lambda_star", ok && r.bracketed ? nlohmann::json(r.lambda_star) : none},
+                      {"bracket", {r.lo, r.bracketed ? nlohmann::json(r.hi) : none}},
+                      {"bracketed", r.bracketed},
+                      {"failure_mode", mode},
+                      {"hinge_joints", joint_indices(r.hinges, "hinge")},
+                      {"sliding_joints", joint_indices(r.hinges, "sliding")},
                       {"trials", r.trials.size()},
                       {"wall_s", r.wall_s},
                       {"error", errors[c]}});

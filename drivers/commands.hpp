@@ -27,7 +27,7 @@ struct CheckOptions {
 };
 
 // The meshed model as JSON for scripts/draw: nodes (current positions), triangles, tri_block,
-// blocks (fixed, role, polygon), joints.
+// blocks (fixed, role, name: the gmsh physical name or "", polygon), joints.
 nlohmann::json model_geometry_json(const Model& model);
 
 // The deformed model for pictures of a failure mode: model_geometry_json of the current state
@@ -36,6 +36,18 @@ nlohmann::json model_geometry_json(const Model& model);
 nlohmann::json failure_mode_json(const Model& model, const std::vector<Hinge>& hinges);
 
 nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges);
+
+// A capacity search in which no trial collapsed has no lambda*: the commands say so in these
+// words (text, JSON "result", sweep CSV "failure_mode"), with the highest lambda that stood.
+inline constexpr const char* kNoCollapse = "no collapse up to lambda_max";
+
+// The failure mode of a finished capacity search in words: "hinging", "sliding",
+// "hinging and sliding", kNoCollapse, or "none found" (a collapse without an open or slid
+// joint at the end of the trial).
+std::string failure_mode_text(const CapacityResult& result);
+
+// The joint indices of the hinges of one kind ("hinge" or "sliding"), space separated.
+std::string joint_list(const std::vector<Hinge>& hinges, const std::string& kind);
 
 int command_check(const Config& config, const CommonOptions& common, const CheckOptions& opts);
 

@@ -144,4 +144,17 @@ Grid make_grid(const std::string& deck_path, const std::vector<std::string>& set
   return grid;
 }
 
+nlohmann::json param_value(const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (!text.empty() && end == text.c_str() + text.size() && std::isfinite(v)) return v;
+  return text;
+}
+
+std::string csv_quote(const std::string& text) {
+  std::string q = "\"";
+  for (char ch : text) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return q + "\"";
+}
+
 }  // namespace voussoir

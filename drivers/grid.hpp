@@ -2,6 +2,7 @@
 // Grids of deck values for `voussoir sweep` and `voussoir stability`: the `--param` axes
 // (lists and ranges), and the grid of validated decks, row-major with the last axis fastest.
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -39,5 +40,12 @@ struct Grid {
 // work) from the deck file, the --set overrides and the axes.
 Grid make_grid(const std::string& deck_path, const std::vector<std::string>& sets,
                const std::vector<GridAxis>& axes);
+
+// A grid value (as written to the deck override) for a JSON summary: a number when the text
+// is one ("0.3" -> 0.3), else the text.
+nlohmann::json param_value(const std::string& text);
+
+// A CSV field in double quotes (quotes inside doubled), for free text such as error messages.
+std::string csv_quote(const std::string& text);
 
 }  // namespace voussoir

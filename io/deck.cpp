@@ -166,7 +166,16 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 // ---------------------------------------------------------------------------------------------
 // The reader: knows where the current value came from and turns every refusal into one line.
 
+// What a key's reader allows, found by handing it a value no reader accepts (a table) in
+// probing mode: the deck reference (io/deck_reference.cpp, `voussoir keys`, docs/deck.md)
+// is thus the reader's own rule, never a copy of it.
+struct KeyProbe {
+  std::string type, unit, allowed;
+};
+
 struct Reader {
+  bool probing = false;                           // fail() throws KeyProbe (describe_key)
+  mutable std::string probe_type, probe_unit;     // what the typed reader being run expects
   std::string source;                             // deck file name (or the text's label)
   std::string deck_dir;                           // for relative input files
   std::map<std::string, std::string> set_raw;     // dotted key -> raw VALUE of its --set
@@ -186,12 +195,21 @@ struct Reader {
     return source + ": ";
   }
 
+  // Notes the type (and unit) a typed reader expects, for probing.
+  void expects(const char* type, const char* unit = nullptr) const {
+    if (!probing) return;
+    probe_type = type;
+    probe_unit = unit ? unit : "";
+  }
+
   [[noreturn]] void fail(const toml::node& n, const std::string& allowed) const {
+    if (probing) throw KeyProbe{probe_type, probe_unit, allowed};
     throw DeckError(
         one_line(where(key, &n) + key + " = " + value_text(n) + ": expected " + allowed));
   }
 
   double number(const toml::node& n, const Range& r, const char* unit = nullptr) const {
+    expects("number", unit);
     const std::string u = unit ? std::string(" [") + unit + "]" : std::string();
     const std::string allowed = describe(r, "a number") + u;
     double v = 0.0;
@@ -208,6 +226,7 @@ struct Reader {
   }
 
   int integer(const toml::node& n, std::int64_t lo, std::int64_t hi) const {
+    expects("integer");
     const std::string allowed =
         "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
     const auto* i = n.as_integer();
@@ -217,6 +236,7 @@ struct Reader {
   }
 
   std::string string(const toml::node& n) const {
+    if (probe_type.empty()) expects("string");
     if (const auto* s = n.as_string()) return s->get();
     // `--set output.file=2024` parses as an integer; for a string key take the text typed.
     if (auto it = set_raw.find(key); it != set_raw.end() && !n.is_array() && !n.is_table())
@@ -225,6 +245,7 @@ struct Reader {
   }
 
   std::string choice(const toml::node& n, const std::vector<std::string>& allowed) const {
+    expects("string");
     const std::string what = "one of \"" + join(allowed, "\", \"") + "\"";
     if (!n.is_string() && !from_set(key)) fail(n, what);
     const std::string s = n.is_string() ? n.as_string()->get() : set_raw.at(key);
@@ -233,6 +254,7 @@ struct Reader {
   }
 
   const toml::array& array(const toml::node& n, const std::string& what) const {
+    expects("array");
     const auto* a = n.as_array();
     if (a == nullptr) fail(n, what);
     return *a;
@@ -241,6 +263,8 @@ struct Reader {
   // A file the run will read: resolved against the deck folder (file keys) or the current
   // directory (--set), and it must be readable.
   std::string input_file(const toml::node& n) const {
+    expects("string (file name)");
+    if (probing) fail(n, "a readable file; a relative name is taken from the deck's folder");
     const std::string s = string(n);
     if (s.empty()) fail(n, "a file name");
     fs::path p(s);
@@ -329,6 +353,7 @@ const std::vector<KeySpec>& key_table() {
       // [solver]
       {"solver.dt", [](Reader& r, const toml::node& n, Config& c) {
          const char* what = "\"auto\" or a time step > 0 [s]";
+         r.expects("\"auto\" or number", "s");
          if (n.is_string() || (r.from_set(r.key) && !n.is_number())) {
            if (r.string(n) != "auto") r.fail(n, what);
            c.solver.dt = 0.0;
@@ -633,6 +658,33 @@ void check_together(const Reader& r, Config& c) {
 }
 
 }  // namespace
+
+KeyRule describe_key(const std::string& key) {
+  const KeySpec* spec = find_key(key);
+  if (spec == nullptr) throw std::invalid_argument("describe_key: unknown deck key " + key);
+  Reader r;
+  r.probing = true;
+  r.source = "(probe)";
+  r.key = key;
+  const toml::table probe;
+  Config scratch;
+  try {
+    spec->apply(r, probe, scratch);
+  } catch (const KeyProbe& p) {
+    KeyRule rule{p.type, p.unit, p.allowed};
+    // "a number > 0 [m, 0 = automatic]" -> allowed "a number > 0; 0 = automatic", unit "m".
+    const std::string suffix = " [" + p.unit + "]";
+    if (!p.unit.empty() && rule.allowed.size() >= suffix.size() &&
+        rule.allowed.compare(rule.allowed.size() - suffix.size(), suffix.size(), suffix) == 0)
+      rule.allowed.resize(rule.allowed.size() - suffix.size());
+    if (const std::size_t comma = p.unit.find(", "); comma != std::string::npos) {
+      rule.allowed += "; " + p.unit.substr(comma + 2);
+      rule.unit = p.unit.substr(0, comma);
+    }
+    return rule;
+  }
+  return {};  // the reader took a table: no rule to show (the reference test refuses this)
+}
 
 const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = [] {

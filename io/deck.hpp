@@ -22,7 +22,17 @@ Config load_deck(const std::string& path, const std::vector<std::string>& overri
 Config parse_deck(const std::string& text, const std::string& source,
                   const std::vector<std::string>& overrides = {}, const std::string& deck_dir = ".");
 
-// Every dotted key the deck accepts ("model.kind", "load.base.signal", ...).
+// Every dotted key the deck accepts ("model.kind", "load.base.signal", ...), in the reader's
+// order.
 const std::vector<std::string>& known_keys();
+
+// What the reader of `key` accepts, as its error messages say it: type ("number", "integer",
+// "string", "array", ...), unit ("m", "Pa", ... or empty) and the allowed values ("a number
+// in (0, 360)", "one of \"strain\", \"stress\"", ...). Throws std::invalid_argument for an
+// unknown key. The deck reference (io/deck_reference.hpp) is built from it.
+struct KeyRule {
+  std::string type, unit, allowed;
+};
+KeyRule describe_key(const std::string& key);
 
 }  // namespace voussoir

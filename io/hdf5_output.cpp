@@ -6,12 +6,14 @@
 //     the calling thread in open(): every failure is reported once, by our exception.
 //   - Every handle lives in an `H5Handle` that closes it, so an exception on any path leaks
 //     nothing and leaves the .tmp file closed and readable.
-//   - XDMF: checked with ParaView 5.11's three readers (XDMF Reader, Xdmf3ReaderS/T): a
-//     "Vector" attribute over the N x 2 velocity is read correctly by all (the Xdmf2 reader pads
-//     it to 3 components, Xdmf3 keeps 2); stress is one 3-component attribute (components
-//     sxx, syy, sxy: colour by component X, Y, Z). Tried and dropped: HyperSlab and JOIN
-//     function data items (per-component stress scalars, zero-padded velocity) work in the
-//     Xdmf2 reader but the Xdmf3 readers skip them.
+//   - XDMF: checked with ParaView 5.11's three readers (XDMF Reader, Xdmf3ReaderS/T). Point
+//     vectors are stored with 3 components (z = 0) in the HDF5 file itself: an N x 2 "Vector"
+//     was kept at 2 components by the Xdmf3 readers and Warp By Vector then aborted
+//     (vtkWarpVector: GetNumberOfComponents() == 3 failed). Stress is five named scalars, each
+//     its own dataset: a 3-component "Vector" stress made ParaView offer X/Y/Z and a
+//     meaningless magnitude. Tried and dropped: HyperSlab and JOIN function data items
+//     (per-component stress scalars, zero-padded velocity) work in the Xdmf2 reader but the
+//     Xdmf3 readers skip them, hence the separate datasets.
 
 #include "io/hdf5_output.hpp"
 
@@ -126,6 +128,10 @@ std::string format_time(double t) {
   const auto res = std::to_chars(buf, buf + sizeof buf, t);
   return std::string(buf, res.ptr);
 }
+
+// Snapshot datasets of the "stress" field, one scalar per triangle [Pa].
+const char* const kStressNames[] = {"stress_xx", "stress_yy", "stress_xy", "stress_1",
+                                    "stress_2"};
 
 std::string snapshot_name(int k) {
   char buf[16];
@@ -460,6 +466,7 @@ void RunWriter::write_snapshot(double time, const Model& model,
 
   s.flush_series();
   const std::string name = "/snapshots/" + snapshot_name(snapshot_count());
+  const std::size_t T = static_cast<std::size_t>(s.tris);
   H5Handle group(
       s.check(H5Gcreate2(s.file.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
               "create " + name),
@@ -470,12 +477,39 @@ void RunWriter::write_snapshot(double time, const Model& model,
     for (std::size_t i = 0; i < N; ++i) s.scratch[2 * i] = a[i], s.scratch[2 * i + 1] = b[i];
     return s.scratch.data();
   };
-  if (s.want_position)
+  // (a - a0, b - b0, 0) per node: a 3-component point vector for ParaView.
+  auto vector3 = [&](const std::vector<double>& a, const std::vector<double>& b,
+                     const std::vector<double>* a0, const std::vector<double>* b0) {
+    s.scratch.assign(3 * N, 0.0);
+    for (std::size_t i = 0; i < N; ++i) {
+      s.scratch[3 * i] = a0 ? a[i] - (*a0)[i] : a[i];
+      s.scratch[3 * i + 1] = b0 ? b[i] - (*b0)[i] : b[i];
+    }
+    return s.scratch.data();
+  };
+  if (s.want_position) {
     s.write_array(group.get(), "position", H5T_NATIVE_DOUBLE, N, 2, interleave(n.x, n.y));
+    s.write_array(group.get(), "displacement", H5T_NATIVE_DOUBLE, N, 3,
+                  vector3(n.x, n.y, &n.x0, &n.y0));
+  }
   if (s.want_velocity)
-    s.write_array(group.get(), "velocity", H5T_NATIVE_DOUBLE, N, 2, interleave(n.vx, n.vy));
-  if (s.want_stress)
-    s.write_array(group.get(), "stress", H5T_NATIVE_DOUBLE, s.tris, 3, stress_xx_yy_xy.data());
+    s.write_array(group.get(), "velocity", H5T_NATIVE_DOUBLE, N, 3,
+                  vector3(n.vx, n.vy, nullptr, nullptr));
+  if (s.want_stress) {
+    // Components and in-plane principal stresses s1,2 = c +- r, c = (sxx + syy) / 2,
+    // r = hypot((sxx - syy) / 2, sxy).
+    std::array<std::vector<double>, 5> parts;
+    for (auto& p : parts) p.resize(T);
+    for (std::size_t e = 0; e < T; ++e) {
+      const double xx = stress_xx_yy_xy[3 * e], yy = stress_xx_yy_xy[3 * e + 1],
+                   xy = stress_xx_yy_xy[3 * e + 2];
+      const double c = 0.5 * (xx + yy), r = std::hypot(0.5 * (xx - yy), xy);
+      parts[0][e] = xx, parts[1][e] = yy, parts[2][e] = xy, parts[3][e] = c + r,
+      parts[4][e] = c - r;
+    }
+    for (std::size_t k = 0; k < parts.size(); ++k)
+      s.write_array(group.get(), kStressNames[k], H5T_NATIVE_DOUBLE, T, 0, parts[k].data());
+  }
   s.snapshot_times.push_back(time);
   s.check(H5Fflush(s.file.get(), H5F_SCOPE_LOCAL), "flush");
 }
@@ -543,16 +577,20 @@ void RunWriter::Impl::write_xdmf() const {
     x << "        <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << T
       << "\" NodesPerElement=\"3\">\n          " << hdf(T + " 3", "Int", 4, "/mesh/triangles")
       << "\n        </Topology>\n";
-    const std::string geometry =
-        !group.empty() && want_position ? group + "/position" : std::string("/mesh/nodes");
-    x << "        <Geometry GeometryType=\"XY\">\n          " << hdf(N + " 2", "Float", 8, geometry)
-      << "\n        </Geometry>\n";
+    // The reference mesh on every grid (one geometry: Warp By Vector on `displacement`
+    // moves it).
+    x << "        <Geometry GeometryType=\"XY\">\n          "
+      << hdf(N + " 2", "Float", 8, "/mesh/nodes") << "\n        </Geometry>\n";
     attribute("block", "Scalar", "Cell", hdf(T, "Int", 4, "/mesh/block"));
     if (group.empty()) return;
+    if (want_position)
+      attribute("displacement", "Vector", "Node",
+                hdf(N + " 3", "Float", 8, group + "/displacement"));
     if (want_velocity)
-      attribute("velocity", "Vector", "Node", hdf(N + " 2", "Float", 8, group + "/velocity"));
+      attribute("velocity", "Vector", "Node", hdf(N + " 3", "Float", 8, group + "/velocity"));
     if (want_stress)
-      attribute("stress", "Vector", "Cell", hdf(T + " 3", "Float", 8, group + "/stress"));
+      for (const char* field : kStressNames)
+        attribute(field, "Scalar", "Cell", hdf(T, "Float", 8, group + "/" + field));
   };
   if (snapshot_times.empty()) {
     // No snapshot: the reference mesh alone, so the file still opens.

@@ -16,9 +16,22 @@
 //                                  active_contacts (int64), energy_balance_error [-]
 //   /series/control_displacement   R x C  (only if records carry control displacements;
 //                                  C fixed by the first record; attribute columns)
-//   /snapshots/NNNNNN/     attribute time [s]; datasets among position (N x 2) [m],
-//                          velocity (N x 2) [m/s], stress (T x 3: sxx, syy, sxy) [Pa],
-//                          only those requested in `fields`
+//   /snapshots/NNNNNN/     attribute time [s]; datasets of the requested `fields`:
+//                            position: position (N x 2) [m] and displacement (N x 3: ux,
+//                              uy, 0; position minus /mesh/nodes) [m],
+//                            velocity: velocity (N x 3: vx, vy, 0) [m/s],
+//                            stress: stress_xx, stress_yy, stress_xy, stress_1, stress_2
+//                              (T each: Cauchy components, in-plane principal stresses
+//                              s1 >= s2) [Pa]
+//
+// XDMF (ParaView): a Temporal collection with a Time value on every grid; the geometry is the
+// reference mesh (/mesh/nodes) and `displacement` a 3-component point vector, so ParaView's
+// Warp By Vector on it draws the deformed blocks (scale factor 1 = true motion, more to
+// magnify); `velocity` is a 3-component point vector; stress is five named cell scalars. Data
+// items name the .h5 by its file name, resolved by the readers against the folder of the
+// .xdmf, so the pair opens from any working directory and can be moved together. Checked with
+// ParaView 5.11's XDMF Reader and Xdmf3ReaderS/T (tests/python/paraview_open.py) and with
+// h5py (tests/python/xdmf_h5.py).
 //
 // Completeness contract (SPEC.md: "no partial file left looking complete"):
 //   - open() removes any earlier `path` and its .xdmf, and writes to `path + ".tmp"` with
@@ -80,7 +93,8 @@ class RunWriter {
   void append_series(const SeriesRecord& record);
 
   // Writes /snapshots/NNNNNN with the requested fields of the current model state.
-  // `stress_xx_yy_xy` holds (sxx, syy, sxy) of each triangle, interleaved (size 3 T) [Pa];
+  // `stress_xx_yy_xy` holds (sxx, syy, sxy) of each triangle, interleaved (size 3 T) [Pa],
+  // written as the named scalars of the layout above;
   // it is read only when "stress" is among the fields (may be empty otherwise).
   void write_snapshot(double time, const Model& model, const std::vector<double>& stress_xx_yy_xy);
 

@@ -121,4 +121,29 @@ double triangle_overlap_area(const std::array<Vec2, 3>& t1, const std::array<Vec
   return poly.size() >= 3 ? std::max(0.0, polygon_area(poly)) : 0.0;
 }
 
+std::vector<Vec2> merge_collinear(const std::vector<Vec2>& polygon, double rel_tol) {
+  const std::size_t n = polygon.size();
+  if (n <= 3) return polygon;
+  // Start at the lexicographically smallest vertex: an extreme point, never inside a side.
+  std::size_t first = 0;
+  double x0 = polygon[0].x, x1 = x0, y0 = polygon[0].y, y1 = y0;
+  for (std::size_t k = 1; k < n; ++k) {
+    const Vec2 p = polygon[k], f = polygon[first];
+    if (p.x < f.x || (p.x == f.x && p.y < f.y)) first = k;
+    x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+  }
+  const double tol = rel_tol * std::hypot(x1 - x0, y1 - y0);
+  std::vector<Vec2> out{polygon[first]};
+  for (std::size_t k = 1; k < n; ++k) {
+    const Vec2 v = polygon[(first + k) % n], w = polygon[(first + k + 1) % n];
+    const Vec2 u = out.back();
+    // v goes when it lies on the segment from the last corner kept to the next vertex.
+    const double len = norm(w - u);
+    const bool on_line = len > tol && std::abs(cross(w - u, v - u)) / len <= tol &&
+                         dot(v - u, w - u) > 0.0 && dot(v - w, u - w) > 0.0;
+    if (!on_line) out.push_back(v);
+  }
+  return out.size() >= 3 ? out : polygon;
+}
+
 }  // namespace voussoir

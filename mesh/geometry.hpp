@@ -55,6 +55,13 @@ double polygon_area(const std::vector<Vec2>& polygon);
 // zero length.
 bool polygon_is_simple(const std::vector<Vec2>& polygon);
 
+// The corners of a closed polygon: every vertex that lies on the straight line through its
+// neighbours (within `rel_tol` x the polygon's size, and between them) is dropped, so a side
+// drawn or meshed with points along it becomes one edge. The joint search (mesh/
+// scenes_polygons.cpp) works on these, so one physical interface is one joint however many
+// mesh nodes lie on it. Never returns fewer than 3 vertices.
+std::vector<Vec2> merge_collinear(const std::vector<Vec2>& polygon, double rel_tol = 1e-9);
+
 // Area of the intersection of two triangles (each given in either orientation) [m2]:
 // Sutherland-Hodgman clipping of one convex polygon by the other.
 double triangle_overlap_area(const std::array<Vec2, 3>& t1, const std::array<Vec2, 3>& t2);

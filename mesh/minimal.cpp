@@ -113,6 +113,7 @@ Model minimal_model(const Model& model, double chord_tolerance) {
   for (const Block& b : model.blocks) {
     const std::vector<Vec2> outline = simplify_outline(b.polygon, chord_tolerance);
     add_block(out, outline, outline, ear_clip(outline), b.fixed, b.role);
+    out.blocks.back().name = b.name;
   }
   finalize_model(out);
   return out;

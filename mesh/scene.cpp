@@ -179,8 +179,10 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
 
   Model model;
   model.kind = scene.kind;
-  for (const BlockSpec& b : scene.blocks)
+  for (const BlockSpec& b : scene.blocks) {
     add_block(model, boundary_loop(b.mesh), b.mesh.points, b.mesh.tris, b.fixed, b.role);
+    model.blocks.back().name = b.name;
+  }
   model.joints = scene.joints;
   model.material.density = params.material.density;
   model.material.young = params.material.young;

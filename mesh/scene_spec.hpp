@@ -43,6 +43,7 @@ struct BlockSpec {
     Given,             // `mesh` already filled (gmsh import)
   };
   std::string role;  // voussoir, crown, abutment, buttress, pier, ground, block
+  std::string name;  // gmsh import: the block's physical name; empty otherwise
   bool fixed = false;
   Outline outline;  // exact outline, counter-clockwise (arcs where the block has arcs)
   Mesher mesher = Mesher::Polygon;

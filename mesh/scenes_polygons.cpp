@@ -30,11 +30,18 @@
 //    tag order. If no surface has a physical tag, each surface is one block (ascending surface
 //    tag). Lines and points are ignored; any other surface element (quadrangles, second-order
 //    triangles) is refused, and so is a block whose triangles do not form one piece without
-//    holes. The mesh is used as is (mesh.size does not apply).
+//    holes. The mesh is used as is (mesh.size does not apply). Each block keeps the name of
+//    its physical surface ($PhysicalNames; "physical TAG" when unnamed, "surface TAG" without
+//    physical tags), which `check` prints beside the block index. docs/gmsh.md is the user's
+//    guide.
 //
 // Joints: every pair of blocks whose outlines share a straight piece (collinear edges,
 // opposite directions, overlapping over more than 1e-9 of the edge) gets a Joint for the
-// shared piece (a = its end with the smaller x, then smaller y; position NaN).
+// shared piece (a = its end with the smaller x, then smaller y; position NaN). The outlines
+// are first reduced to their corners (merge_collinear, mesh/geometry.hpp): a gmsh block's
+// boundary has a node every mesh edge along a straight side, and a polygon file may give
+// points along a side; either way one physical interface is one joint. (Before, a 3 x 2
+// gmsh wall on a ground had 46 joints, one per pair of facing mesh edges; now 10.)
 
 #include <algorithm>
 #include <cctype>
@@ -132,6 +139,7 @@ std::vector<std::vector<Vec2>> read_polygon_text(const std::string& text, const 
 struct GmshBlocks {
   std::vector<TriMesh> meshes;
   std::vector<int> tags;
+  std::vector<std::string> names;  // physical name, "physical TAG" or "surface TAG"
 };
 
 GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
@@ -139,6 +147,7 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
   std::string tok;
   auto fail = [&](const std::string& why) { throw FileError{name + ": " + why}; };
   std::map<int, int> surface_physical;  // surface tag -> first physical tag (absent: none)
+  std::map<int, std::string> physical_names;  // physical surface tag -> its name
   std::map<std::size_t, std::array<double, 3>> nodes;
   std::map<int, std::vector<std::array<std::size_t, 3>>> surface_tris;
   bool format_ok = false;
@@ -153,6 +162,19 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
       if (binary != 0) fail("binary gmsh files are not supported; save as ASCII");
       format_ok = true;
       in >> tok;  // $EndMeshFormat
+    } else if (tok == "$PhysicalNames") {
+      std::size_t count = 0;
+      if (!(in >> count)) fail("unreadable $PhysicalNames");
+      for (std::size_t k = 0; k < count; ++k) {
+        int dim = 0, tag = 0;
+        std::string rest;
+        if (!(in >> dim >> tag) || !std::getline(in, rest)) fail("unreadable physical name");
+        rest = trim(rest);
+        if (rest.size() >= 2 && rest.front() == '"' && rest.back() == '"')
+          rest = rest.substr(1, rest.size() - 2);
+        if (dim == 2) physical_names[tag] = rest;
+      }
+      in >> tok;  // $EndPhysicalNames
     } else if (tok == "$Entities") {
       std::size_t np = 0, nc = 0, nsurf = 0, nvol = 0;
       if (!(in >> np >> nc >> nsurf >> nvol)) fail("unreadable $Entities");
@@ -271,6 +293,11 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
     }
     out.meshes.push_back(std::move(mesh));
     out.tags.push_back(tag);
+    const auto named = physical_names.find(tag);
+    out.names.push_back(!any_phys ? "surface " + std::to_string(tag)
+                        : named != physical_names.end() && !named->second.empty()
+                            ? named->second
+                            : "physical " + std::to_string(tag));
   }
   return out;
 }
@@ -348,6 +375,7 @@ Scene build_polygons_scene(const SceneParams& params) {
         spec.mesher = BlockSpec::Mesher::Given;
         spec.mesh = std::move(g.meshes[b]);
         spec.outline = polygon_outline(loop);
+        spec.name = g.names[b];
         outlines.push_back(loop);
         scene.blocks.push_back(std::move(spec));
       }
@@ -375,6 +403,16 @@ Scene build_polygons_scene(const SceneParams& params) {
         std::find(mc.fixed.begin(), mc.fixed.end(), static_cast<int>(b)) != mc.fixed.end();
     scene.blocks[b].fixed = fixed;
     scene.blocks[b].role = fixed ? "ground" : "block";
+  }
+  // A model with nothing free cannot run (no trial can move, limit analysis has no unknown):
+  // refused here, for every command, as a bad deck.
+  if (mc.fixed.size() >= nb) {
+    std::string list = "[";
+    for (std::size_t k = 0; k < mc.fixed.size(); ++k)
+      list += (k ? ", " : "") + std::to_string(mc.fixed[k]);
+    geometry_error(params, "model.fixed", list + "]",
+                   "every block of the file is fixed (it has " + std::to_string(nb) +
+                       "); leave at least one block out of model.fixed");
   }
 
   // Element size from the smallest free block (all blocks if none is free).
@@ -451,7 +489,9 @@ Scene build_polygons_scene(const SceneParams& params) {
       }
     }
   }
-  find_joints(scene, outlines);
+  std::vector<std::vector<Vec2>> corners;
+  for (const auto& p : outlines) corners.push_back(merge_collinear(p));
+  find_joints(scene, corners);
   return scene;
 }
 

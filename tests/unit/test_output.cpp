@@ -263,24 +263,47 @@ TEST(RunWriter, WritesMeshSeriesSnapshotsAndCompletes) {
   EXPECT_DOUBLE_EQ(attr_double(f.id, "/snapshots/000000", "time"), 0.1);
   EXPECT_DOUBLE_EQ(attr_double(f.id, "/snapshots/000001", "time"), 0.25);
   EXPECT_EQ(dims_of(f.id, "/snapshots/000000/position"), (std::vector<hsize_t>{7, 2}));
-  EXPECT_EQ(dims_of(f.id, "/snapshots/000000/velocity"), (std::vector<hsize_t>{7, 2}));
-  EXPECT_EQ(dims_of(f.id, "/snapshots/000000/stress"), (std::vector<hsize_t>{3, 3}));
+  // Point vectors with 3 components (z = 0), as ParaView's filters want them.
+  EXPECT_EQ(dims_of(f.id, "/snapshots/000000/displacement"), (std::vector<hsize_t>{7, 3}));
+  EXPECT_EQ(dims_of(f.id, "/snapshots/000000/velocity"), (std::vector<hsize_t>{7, 3}));
   const auto p0 = read_doubles(f.id, "/snapshots/000000/position");
+  const auto u0 = read_doubles(f.id, "/snapshots/000000/displacement");
   const auto v0 = read_doubles(f.id, "/snapshots/000000/velocity");
   const auto p1 = read_doubles(f.id, "/snapshots/000001/position");
   const auto v1 = read_doubles(f.id, "/snapshots/000001/velocity");
   for (Index i = 0; i < 7; ++i) {
     EXPECT_EQ(p0[2 * i], pos1x[i]);
     EXPECT_EQ(p0[2 * i + 1], pos1y[i]);
-    EXPECT_EQ(v0[2 * i], vel1x[i]);
+    EXPECT_EQ(u0[3 * i], pos1x[i] - m.nodes.x0[i]);
+    EXPECT_EQ(u0[3 * i + 1], pos1y[i] - m.nodes.y0[i]);
+    EXPECT_EQ(u0[3 * i + 2], 0.0);
+    EXPECT_EQ(v0[3 * i], vel1x[i]);
+    EXPECT_EQ(v0[3 * i + 2], 0.0);
     EXPECT_EQ(p1[2 * i], m.nodes.x[i]);
     EXPECT_EQ(p1[2 * i + 1], m.nodes.y[i]);
-    EXPECT_EQ(v1[2 * i], m.nodes.vx[i]);
-    EXPECT_EQ(v1[2 * i + 1], m.nodes.vy[i]);
+    EXPECT_EQ(v1[3 * i], m.nodes.vx[i]);
+    EXPECT_EQ(v1[3 * i + 1], m.nodes.vy[i]);
   }
   EXPECT_NE(p0, p1);  // the block moved between the snapshots
-  EXPECT_EQ(read_doubles(f.id, "/snapshots/000000/stress"), s1);
-  EXPECT_EQ(read_doubles(f.id, "/snapshots/000001/stress"), stress_of(m, 2e5));
+  // Stress: named scalars, the components as given and the principal stresses.
+  for (const auto& [snap, st] :
+       {std::pair{std::string("000000"), s1}, std::pair{std::string("000001"), stress_of(m, 2e5)}}) {
+    const std::string g = "/snapshots/" + snap + "/";
+    EXPECT_EQ(dims_of(f.id, g + "stress_xx"), (std::vector<hsize_t>{3}));
+    const auto xx = read_doubles(f.id, g + "stress_xx"), yy = read_doubles(f.id, g + "stress_yy"),
+               xy = read_doubles(f.id, g + "stress_xy"), s_1 = read_doubles(f.id, g + "stress_1"),
+               s_2 = read_doubles(f.id, g + "stress_2");
+    for (std::size_t e = 0; e < 3; ++e) {
+      EXPECT_EQ(xx[e], st[3 * e]);
+      EXPECT_EQ(yy[e], st[3 * e + 1]);
+      EXPECT_EQ(xy[e], st[3 * e + 2]);
+      // Invariants: trace and determinant of the in-plane tensor.
+      const double scale = std::abs(xx[e]) + std::abs(yy[e]) + std::abs(xy[e]);
+      EXPECT_NEAR(s_1[e] + s_2[e], xx[e] + yy[e], 1e-12 * scale);
+      EXPECT_NEAR(s_1[e] * s_2[e], xx[e] * yy[e] - xy[e] * xy[e], 1e-12 * scale * scale);
+      EXPECT_GE(s_1[e], s_2[e]);
+    }
+  }
 
   // XDMF beside it: a temporal collection naming the final .h5 and each snapshot's datasets.
   const fs::path xdmf = dir / "run.xdmf";
@@ -295,11 +318,17 @@ TEST(RunWriter, WritesMeshSeriesSnapshotsAndCompletes) {
   EXPECT_NE(x.find("GeometryType=\"XY\""), std::string::npos);
   EXPECT_EQ(count_of(x, "run.h5:/mesh/triangles"), 2u);
   EXPECT_EQ(count_of(x, "run.h5:/mesh/block"), 2u);
+  EXPECT_EQ(count_of(x, "run.h5:/mesh/nodes"), 2u);  // the reference geometry on every grid
   for (const char* s : {"000000", "000001"}) {
-    for (const char* d : {"position", "velocity", "stress"})
+    for (const char* d : {"displacement", "velocity", "stress_xx", "stress_yy", "stress_xy",
+                          "stress_1", "stress_2"})
       EXPECT_NE(x.find(std::string("run.h5:/snapshots/") + s + "/" + d), std::string::npos)
           << s << "/" << d;
   }
+  // Vectors are declared with their 3 components; no stress "Vector".
+  EXPECT_EQ(count_of(x, "AttributeType=\"Vector\""), 4u);
+  EXPECT_EQ(count_of(x, "Dimensions=\"7 3\""), 4u);
+  EXPECT_EQ(count_of(x, "Dimensions=\"7 2\""), 2u);  // the geometry only
   EXPECT_EQ(x.find(".tmp"), std::string::npos) << "XDMF must name the final file";
   EXPECT_EQ(count_of(x, "<Grid "), count_of(x, "</Grid>"));
   fs::remove_all(dir);
@@ -346,7 +375,8 @@ TEST(RunWriter, OnlyRequestedFieldsAreWritten) {
   File f(h5);
   EXPECT_TRUE(has_link(f.id, "/snapshots/000000/velocity"));
   EXPECT_FALSE(has_link(f.id, "/snapshots/000000/position"));
-  EXPECT_FALSE(has_link(f.id, "/snapshots/000000/stress"));
+  EXPECT_FALSE(has_link(f.id, "/snapshots/000000/displacement"));
+  EXPECT_FALSE(has_link(f.id, "/snapshots/000000/stress_xx"));
   const std::string x = read_text(dir / "v.xdmf");
   EXPECT_NE(x.find("v.h5:/snapshots/000000/velocity"), std::string::npos);
   EXPECT_NE(x.find("v.h5:/mesh/nodes"), std::string::npos);  // geometry: reference positions
