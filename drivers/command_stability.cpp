@@ -43,12 +43,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   // Resume (drivers/journal.hpp): one record per finished cell under the fingerprint of the
   // deck, its overrides, the axes, the criteria and whether modes are kept.
   Fnv print;
-  print.text(deck_path);
-  for (const std::string& set : sets) print.text(set);
-  for (const GridAxis& a : axes) {
-    print.text(a.key);
-    for (const std::string& v : a.values) print.text(v);
-  }
+  fingerprint_grid(print, deck_path, sets, axes);
   for (double v : {crit.ke_time, crit.trial.max_time, common.limits.drift_limit,
                    double(common.limits.max_steps), keep_modes ? 1.0 : 0.0})
     print.value(v);

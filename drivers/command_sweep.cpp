@@ -54,12 +54,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   // result}) under the fingerprint of the deck, overrides, axes and criteria; cells found
   // there are not run again.
   Fnv print;
-  print.text(deck_path);
-  for (const std::string& set : sets) print.text(set);
-  for (const GridAxis& a : axes) {
-    print.text(a.key);
-    for (const std::string& v : a.values) print.text(v);
-  }
+  fingerprint_grid(print, deck_path, sets, axes);
   print.value(opts.points);
   print.value(criteria.settle_max_time);
   if (criteria.quasi_static) print.text("quasi-static");

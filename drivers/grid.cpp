@@ -157,4 +157,14 @@ std::string csv_quote(const std::string& text) {
   return q + "\"";
 }
 
+void fingerprint_grid(Fnv& print, const std::string& deck_path,
+                      const std::vector<std::string>& sets, const std::vector<GridAxis>& axes) {
+  print.text(deck_path);
+  for (const std::string& set : sets) print.text(set);
+  for (const GridAxis& a : axes) {
+    print.text(a.key);
+    for (const std::string& v : a.values) print.text(v);
+  }
+}
+
 }  // namespace voussoir

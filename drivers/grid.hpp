@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/fnv.hpp"
 #include "core/schema.hpp"
 
 namespace voussoir {
@@ -44,6 +45,11 @@ Grid make_grid(const std::string& deck_path, const std::vector<std::string>& set
 // A grid value (as written to the deck override) for a JSON summary: a number when the text
 // is one ("0.3" -> 0.3), else the text.
 nlohmann::json param_value(const std::string& text);
+
+// Adds to `print` (core/fnv.hpp) what a grid of runs depends on: the deck path, its overrides
+// and the axes with their values (the journals of `sweep` and `stability`).
+void fingerprint_grid(Fnv& print, const std::string& deck_path,
+                      const std::vector<std::string>& sets, const std::vector<GridAxis>& axes);
 
 // A CSV field in double quotes (quotes inside doubled), for free text such as error messages.
 std::string csv_quote(const std::string& text);

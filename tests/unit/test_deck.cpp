@@ -91,6 +91,8 @@ band = [0.5, 25]
 lambda_min = 0.1
 lambda_max = 1.5
 tolerance = 0.01
+local_damping = 0.6
+local_damping_mode = "full"
 
 [output]
 file = "run.h5"
@@ -192,6 +194,8 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.capacity.lambda_min, 0.1);
   EXPECT_DOUBLE_EQ(c.capacity.lambda_max, 1.5);
   EXPECT_DOUBLE_EQ(c.capacity.tolerance, 0.01);
+  EXPECT_DOUBLE_EQ(c.capacity.local_damping, 0.6);
+  EXPECT_EQ(c.capacity.local_damping_mode, "full");
   EXPECT_EQ(c.output.file, "run.h5");  // output paths stay relative to the working directory
   EXPECT_DOUBLE_EQ(c.output.every, 0.02);
   EXPECT_EQ(c.output.fields, (std::vector<std::string>{"velocity", "stress"}));
