@@ -147,6 +147,9 @@ int main(int argc, char** argv) {
                     "relative amplitude step of --search step (default 0.05: 5% a step)");
   pulse->add_option("--steps-above", pulse_opts.steps_above,
                     "steps run past the first collapse, to find survivals above it (default 2)");
+  pulse->add_option("--free-time", pulse_opts.free_time,
+                    "free motion after the signal before an undecided run is classified by its "
+                    "trend [s] (default 1.5)");
   pulse->add_option("--tilt-reference", pulse_opts.tilt_reference,
                     "a measured tilting capacity to report lambda* against");
 

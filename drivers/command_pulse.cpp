@@ -68,6 +68,7 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
   const auto wall0 = Clock::now();
   PulseCriteria crit;
   crit.settle.limits = common.limits;
+  crit.free_time = opts.free_time;
   const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
   if (signal.kind() == BaseSignal::Kind::None)
     throw DeckError(config.deck_path +
@@ -191,12 +192,12 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
 
 int curve_run(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
   const auto wall0 = Clock::now();
-  validate_curve_options(opts);
   if (config.load.base.signal != "windowed_sine" && config.load.base.signal != "sine_pulse")
     throw DeckError(config.deck_path + ": load.base.signal = \"" + config.load.base.signal +
                     "\": pulse --curve needs an analytic pulse (windowed_sine or sine_pulse)");
   PulseCriteria crit;
   crit.settle.limits = common.limits;
+  crit.free_time = opts.free_time;
 
   double lambda_star = opts.lambda_star;
   double capacity_wall = 0.0;
@@ -224,11 +225,16 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   const SettledState settled = settle(config, crit.settle, common.quiet);
   if (!settled.settled) throw RunError(unsettled_message(settled, crit.settle));
 
-  // Lowest frequencies (longest pulses) first for the dynamic schedule.
+  // The costliest frequencies first for the dynamic schedule: for the bisection the lowest (the
+  // longest pulses), for the stepping search the highest (the most steps from the quasi-static
+  // start: 51 runs at 12 Hz against 6 at 2 Hz on scaled_arch). The order changes no result.
   std::vector<double> freqs = opts.freqs;
   std::vector<int> order(freqs.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return freqs[a] < freqs[b]; });
+  const bool highest_first = search.search == AmplitudeSearch::Step;
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return highest_first ? freqs[a] > freqs[b] : freqs[a] < freqs[b];
+  });
   std::vector<CurvePoint> points(freqs.size());
   std::vector<std::string> errors(freqs.size());
   const int n = static_cast<int>(freqs.size());
@@ -360,6 +366,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
 }  // namespace
 
 int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
+  validate_pulse_options(opts);
   return opts.curve ? curve_run(config, common, opts) : single_run(config, common, opts);
 }
 

@@ -329,12 +329,16 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
   return cp;
 }
 
-void validate_curve_options(const PulseOptions& opts) {
+void validate_pulse_options(const PulseOptions& opts) {
   auto number = [](double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", v);
     return std::string(buf);
   };
+  if (!(opts.free_time > 0.0 && std::isfinite(opts.free_time)))
+    throw DeckError("pulse --free-time " + number(opts.free_time) +
+                    " s is not allowed: the free motion after the signal must be a positive time");
+  if (!opts.curve) return;
   if (opts.freqs.empty()) throw DeckError("pulse --curve needs --freqs F1,F2,... (Hz)");
   for (double f : opts.freqs)
     if (!(f > 0.0) || !std::isfinite(f))

@@ -190,13 +190,14 @@ struct PulseOptions {
   bool start_given = false;
   double step = 0.05;           // --step: relative amplitude step of the stepping search
   int steps_above = 2;          // --steps-above N: steps past the first collapse
+  double free_time = 1.5;       // --free-time S: PulseCriteria::free_time [s]
   double tilt_reference = 0.0;  // --tilt-reference X: a measured tilting capacity to compare
   bool tilt_reference_given = false;
 };
 
-// Checks the curve options and frequencies (DeckError, exit 2, naming the option and what is
-// allowed).
-void validate_curve_options(const PulseOptions& opts);
+// Checks the options (the curve's search and frequencies with --curve): DeckError (exit 2)
+// naming the option, the value and what is allowed.
+void validate_pulse_options(const PulseOptions& opts);
 
 int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts);
 
