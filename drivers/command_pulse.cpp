@@ -301,7 +301,10 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
       std::printf("%10s survived above A_c (non-monotone) at %s g\n", "",
                   list_of(p.stable_above, ", ").c_str());
   }
-  std::printf("curve %s; %.1f s wall in all\n", csv_path.c_str(), wall);
+  double worst = 0.0;
+  for (const CurvePoint& p : points) worst = std::max(worst, p.max_energy_balance_error);
+  std::printf("largest energy balance error of any run %.2e; curve %s; %.1f s wall in all\n", worst,
+              csv_path.c_str(), wall);
   if (!opts.plot.empty()) {
     draw_with_script("plot_curve", {csv_path, "-o", opts.plot}, opts.plot);
   }
