@@ -71,8 +71,9 @@ int main(int argc, char** argv) {
       app.add_subcommand("capacity", "collapse load factor lambda* by bisection on lambda");
   add_common(capacity, deck, common);
   voussoir::add_limit_options(capacity, common.limits);
-  capacity->add_option("--points", cap_opts.points,
-                       "trial lambdas per bisection round, run in parallel (default 2)")
+  capacity
+      ->add_option("--points", cap_opts.points,
+                   "trial lambdas per bisection round, run in parallel (default 2)")
       ->check(CLI::Range(1, 64));
 
   capacity->add_flag("--no-seed", cap_opts.no_seed,
@@ -86,14 +87,17 @@ int main(int argc, char** argv) {
   // Trial criteria (defaults and their study: docs/capacity.md).
   capacity->add_option("--ramp-time", cap_opts.criteria.ramp_time, "load ramp [s]")
       ->check(CLI::PositiveNumber);
-  capacity->add_option("--collapse-displacement", cap_opts.criteria.collapse_displacement,
-                       "collapse when a block moves this x L_ref")
+  capacity
+      ->add_option("--collapse-displacement", cap_opts.criteria.collapse_displacement,
+                   "collapse when a block moves this x L_ref")
       ->check(CLI::PositiveNumber);
-  capacity->add_option("--collapse-rotation", cap_opts.criteria.collapse_rotation,
-                       "collapse when a block rotates this [rad]")
+  capacity
+      ->add_option("--collapse-rotation", cap_opts.criteria.collapse_rotation,
+                   "collapse when a block rotates this [rad]")
       ->check(CLI::PositiveNumber);
-  capacity->add_option("--rest-speed", cap_opts.criteria.rest_speed,
-                       "at rest below this x sqrt(g L_ref)")
+  capacity
+      ->add_option("--rest-speed", cap_opts.criteria.rest_speed,
+                   "at rest below this x sqrt(g L_ref)")
       ->check(CLI::PositiveNumber);
   capacity->add_option("--hold-time", cap_opts.criteria.hold_time, "rest hold window [s]")
       ->check(CLI::PositiveNumber);
@@ -126,7 +130,8 @@ int main(int argc, char** argv) {
   pulse->add_option("-o,--output", pulse_opts.output, "HDF5 output file (overrides output.file)");
   pulse->add_option("--series", pulse_opts.series,
                     "CSV time series of the run (input, energy, control points)");
-  pulse->add_flag("--curve", pulse_opts.curve, "failure curve: bisection on the amplitude");
+  pulse->add_flag("--curve", pulse_opts.curve,
+                  "failure curve: the collapse amplitude per frequency (--search)");
   pulse->add_option("--freqs", pulse_opts.freqs, "curve frequencies F1,F2,... [Hz]")
       ->delimiter(',');
   pulse->add_option("--csv", pulse_opts.csv, "curve CSV (default curve.csv)");
@@ -137,17 +142,32 @@ int main(int argc, char** argv) {
                     "relative bracket width of the amplitude (default 0.02)");
   pulse->add_option("--points", pulse_opts.points, "capacity trials per round (default 2)")
       ->check(CLI::Range(1, 64));
+  pulse->add_option("--search", pulse_opts.search,
+                    "curve amplitude search: step (raise A step by step, then bisect the first "
+                    "collapsing step; default) or bisect (grow by 1.5, then bisect)");
+  pulse->add_option("--start", pulse_opts.start,
+                    "first amplitude of the curve search [g] (default lambda*/peak factor; "
+                    "bisect: lambda*)");
+  pulse->add_option("--step", pulse_opts.step,
+                    "relative amplitude step of --search step (default 0.05: 5% a step)");
+  pulse->add_option("--steps-above", pulse_opts.steps_above,
+                    "steps run past the first collapse, to find survivals above it (default 2)");
+  pulse->add_option("--free-time", pulse_opts.free_time,
+                    "free motion after the signal before an undecided run is classified by its "
+                    "trend [s] (default 1.5)");
+  pulse->add_option("--tilt-reference", pulse_opts.tilt_reference,
+                    "a measured tilting capacity to report lambda* against");
 
   voussoir::SweepOptions sweep_opts;
   CLI::App* sweep = app.add_subcommand("sweep", "capacity over a grid of deck values");
   add_common(sweep, deck, common);
   voussoir::add_limit_options(sweep, common.limits);
-  sweep->add_option("--param", sweep_opts.params, "KEY=V1,V2,... (repeat for a grid)")
-      ->required();
+  sweep->add_option("--param", sweep_opts.params, "KEY=V1,V2,... (repeat for a grid)")->required();
   sweep->add_option("--csv", sweep_opts.csv, "CSV output (default sweep.csv)");
   sweep->add_option("--plot", sweep_opts.plot, "PNG plot of lambda* over the grid");
-  sweep->add_option("--settle-time", sweep_opts.criteria.settle_max_time,
-                    "longest settle under gravity before each cell's trials [s]")
+  sweep
+      ->add_option("--settle-time", sweep_opts.criteria.settle_max_time,
+                   "longest settle under gravity before each cell's trials [s]")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sweep->add_flag("--dynamic", sweep_opts.dynamic,
@@ -162,9 +182,10 @@ int main(int argc, char** argv) {
       "stability", "gravity-only stability map over a grid (kinetic-energy criterion)");
   add_common(stability, deck, common);
   voussoir::add_limit_options(stability, common.limits);
-  stability->add_option("--param", stab_opts.params,
-                        "KEY=V1,V2,... or KEY=start:stop:step (repeat for a grid); "
-                        "model.thickness_ratio=R sets model.thickness = R x model.radius")
+  stability
+      ->add_option("--param", stab_opts.params,
+                   "KEY=V1,V2,... or KEY=start:stop:step (repeat for a grid); "
+                   "model.thickness_ratio=R sets model.thickness = R x model.radius")
       ->required();
   stability->add_option("--csv", stab_opts.csv, "CSV output (default stability.csv)");
   stability->add_option("--plot", stab_opts.plot, "PNG map (scripts/plot_stability)");
@@ -194,8 +215,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (common.threads > 0) omp_set_num_threads(common.threads);
-    if (sweep->parsed())
-      return voussoir::command_sweep(deck.deck, deck.sets, common, sweep_opts);
+    if (sweep->parsed()) return voussoir::command_sweep(deck.deck, deck.sets, common, sweep_opts);
     if (stability->parsed())
       return voussoir::command_stability(deck.deck, deck.sets, common, stab_opts);
     const voussoir::Config config = voussoir::load_deck(deck.deck, deck.sets);
@@ -203,7 +223,11 @@ int main(int argc, char** argv) {
     if (run->parsed()) return voussoir::command_run(config, common, run_opts);
     if (capacity->parsed()) return voussoir::command_capacity(config, common, cap_opts);
     if (limit->parsed()) return voussoir::command_limit(config, common, limit_opts);
-    if (pulse->parsed()) return voussoir::command_pulse(config, common, pulse_opts);
+    if (pulse->parsed()) {
+      pulse_opts.start_given = pulse->count("--start") > 0;
+      pulse_opts.tilt_reference_given = pulse->count("--tilt-reference") > 0;
+      return voussoir::command_pulse(config, common, pulse_opts);
+    }
   } catch (const voussoir::DeckError& e) {
     std::fprintf(stderr, "voussoir: error: %s\n", e.what());
     return 2;

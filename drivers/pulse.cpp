@@ -237,8 +237,20 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   return r;
 }
 
+std::vector<double> stable_above_collapse(const std::vector<PulseResult>& runs) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const PulseResult& r : runs)
+    if (r.collapsed) lowest = std::min(lowest, r.amplitude_g);
+  std::vector<double> out;
+  for (const PulseResult& r : runs)
+    if (!r.collapsed && r.amplitude_g > lowest) out.push_back(r.amplitude_g);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
-                                   double frequency, double a0, double tolerance,
+                                   double frequency, const AmplitudeSearchOptions& search,
                                    const PulseCriteria& crit, bool quiet) {
   const auto wall0 = Clock::now();
   CurvePoint cp;
@@ -260,14 +272,16 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     return r.collapsed;
   };
 
-  // Bracket: up from a0 until a collapse, or down from a0 until a survival.
+  // Bracket: up from the start by `growth` until a collapse, or down until a survival.
+  const bool stepping = search.search == AmplitudeSearch::Step;
+  const double growth = stepping ? 1.0 + search.step : kBracketGrowth;
   double lo = 0.0, hi = 0.0;
   bool have_hi = false, have_lo = false;
-  double a = a0;
+  double a = search.start;
   if (trial(a)) {
     hi = a, have_hi = true;
     while (!have_lo && a > 1e-3) {
-      a /= kBracketGrowth;
+      a /= growth;
       if (trial(a)) {
         hi = a;
       } else {
@@ -276,8 +290,8 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     }
   } else {
     lo = a, have_lo = true;
-    while (!have_hi && a * kBracketGrowth <= kMaxAmplitude) {
-      a *= kBracketGrowth;
+    while (!have_hi && a * growth <= kMaxAmplitude) {
+      a *= growth;
       if (trial(a)) {
         hi = a, have_hi = true;
       } else {
@@ -286,10 +300,11 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     }
   }
   cp.bracketed = have_hi;
+  const double first_collapse = hi;
   if (have_hi) {  // bisection (drivers/bracket.hpp)
     Bracket b{lo, hi};
     shrink_bracket(
-        b, tolerance, 1, ProbePlacement::Midpoint,
+        b, search.tolerance, 1, ProbePlacement::Midpoint,
         [&](const std::vector<double>& amplitudes) {
           return std::vector<bool>{trial(amplitudes[0])};
         },
@@ -297,12 +312,60 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     lo = b.lo;
     hi = b.hi;
   }
+  // Stepping: the steps above the first collapse (non-monotone check; A_c stays hi).
+  if (stepping && have_hi) {
+    double above = first_collapse;
+    for (int k = 0; k < search.steps_above && above * growth <= kMaxAmplitude; ++k) {
+      above *= growth;
+      trial(above);
+    }
+  }
   cp.lo = lo;
   cp.hi = have_hi ? hi : lo;
   cp.amplitude = cp.hi;
+  cp.stable_above = stable_above_collapse(cp.runs);
   cp.trials = static_cast<int>(cp.runs.size());
   cp.wall_s = seconds_since(wall0);
   return cp;
+}
+
+void validate_pulse_options(const PulseOptions& opts) {
+  auto number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  if (!(opts.free_time > 0.0 && std::isfinite(opts.free_time)))
+    throw DeckError("pulse --free-time " + number(opts.free_time) +
+                    " s is not allowed: the free motion after the signal must be a positive time");
+  if (!opts.curve) return;
+  if (opts.freqs.empty()) throw DeckError("pulse --curve needs --freqs F1,F2,... (Hz)");
+  for (double f : opts.freqs)
+    if (!(f > 0.0) || !std::isfinite(f))
+      throw DeckError("pulse --freqs: frequency " + number(f) +
+                      " Hz is not allowed: every frequency must be a positive number of Hz");
+  if (opts.search != "step" && opts.search != "bisect")
+    throw DeckError("pulse --search \"" + opts.search +
+                    "\" is not allowed: use \"step\" (raise the amplitude step by step, the "
+                    "default) or \"bisect\"");
+  if (opts.start_given && !(opts.start > 0.0 && std::isfinite(opts.start)))
+    throw DeckError("pulse --start " + number(opts.start) +
+                    " g is not allowed: the first amplitude must be a positive number of g");
+  if (!(opts.step > 0.0 && std::isfinite(opts.step)))
+    throw DeckError("pulse --step " + number(opts.step) +
+                    " is not allowed: the relative amplitude step must be positive (0.05: each "
+                    "step 5% above the last)");
+  if (opts.steps_above < 0)
+    throw DeckError("pulse --steps-above " + std::to_string(opts.steps_above) +
+                    " is not allowed: the number of steps past the first collapse must be 0 or "
+                    "more");
+  if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
+    throw DeckError("pulse --tolerance " + number(opts.tolerance) +
+                    " is not allowed: the relative bracket width must lie in (0, 1)");
+  if (opts.tilt_reference_given &&
+      !(opts.tilt_reference > 0.0 && std::isfinite(opts.tilt_reference)))
+    throw DeckError("pulse --tilt-reference " + number(opts.tilt_reference) +
+                    " is not allowed: a measured tilting capacity must be a positive number");
 }
 
 }  // namespace voussoir

@@ -34,15 +34,28 @@
 // peak response alone, only from falling or from what remains after it.
 //
 // Failure curve (`pulse --curve`): for each frequency f, the smallest amplitude A [g] of the
-// deck's signal that collapses the structure, by bisection: bracket from A0 = lambda* (below
-// it a pulse cannot collapse a structure whose quasi-static capacity is lambda*, up to dynamic
-// effects: the windowed sine peaks at about 0.88 A) growing by kBracketGrowth until a collapse
-// (at most kMaxAmplitude g), then bisection until hi - lo <= tolerance x hi; A_c = hi, the
-// smallest amplitude seen to collapse (conservative by at most the tolerance). Rocking
-// structures can respond non-monotonically to amplitude (collapse at A, survive at a larger
-// A); bisection finds one threshold of the bracket, reported with its bracket. Frequencies run
-// in parallel (OpenMP, one frequency per thread, dynamic schedule), each from a copy of one
-// settled state; the result for a frequency does not depend on the thread count.
+// deck's signal that collapses the structure. Rocking makes collapse non-monotonic in A (a
+// larger pulse can leave a rocking structure standing where a smaller one felled it: a slender
+// block overturns after one impact in a band of amplitudes, survives above it, and overturns
+// without impact higher still; Zhang & Makris 2001), so "the smallest" depends on how A is
+// searched. Two searches (AmplitudeSearch):
+//   Step    (default; the shaking-table protocol): A_0 = start (default the quasi-static value
+//           lambda* / peak factor: a pulse that peaks below lambda* g cannot tip a structure
+//           whose tilting capacity is lambda*, up to dynamic effects), A_{k+1} = A_k (1 + step)
+//           (step 0.05: each step 5% above the last) until the first collapse A_k (at most
+//           kMaxAmplitude g; if A_0 already collapses, down by the same factor until a survival),
+//           then bisection inside [A_{k-1}, A_k] until hi - lo <= tolerance x hi. Then
+//           `steps_above` further steps above A_k, A_k (1 + step)^j, look for amplitudes that
+//           survive above a collapsing one (reported, never used to move A_c).
+//   Bisect  (the search before issue 25): from A_0 = start (default lambda*) growing by
+//           kBracketGrowth until a collapse (down by it if A_0 collapses), then bisection.
+//           Fewer runs, but a growth step can jump over a collapse band and report the upper
+//           threshold (tests/unit/test_pulse_stepping.cpp shows it on a slender block).
+// Both give A_c = hi, the smallest amplitude seen to collapse (conservative by at most the
+// tolerance), and `stable_above`: every amplitude run that survived above A_c (empty for a
+// response found monotone). Frequencies run in parallel (OpenMP, one frequency per thread,
+// dynamic schedule), each from a copy of one settled state; the result for a frequency does
+// not depend on the thread count.
 
 #include <functional>
 #include <string>
@@ -135,28 +148,56 @@ struct CurvePoint {
   int trials = 0;
   double wall_s = 0.0;
   double max_energy_balance_error = 0.0;  // over the trials
+  // Amplitudes [g] that survived above `amplitude` (ascending): a non-monotone response.
+  std::vector<double> stable_above;
   std::vector<PulseResult> runs;
 };
 
 constexpr double kBracketGrowth = 1.5;
 constexpr double kMaxAmplitude = 20.0;  // [g]
 
-// The collapse amplitude at one frequency (header comment); `a0` > 0 is the first trial [g].
+enum class AmplitudeSearch { Step, Bisect };
+
+// How `find_collapse_amplitude` searches A (header comment).
+struct AmplitudeSearchOptions {
+  AmplitudeSearch search = AmplitudeSearch::Step;
+  double start = 0.0;       // [g] first amplitude, > 0
+  double step = 0.05;       // Step: relative increment, A_{k+1} = A_k (1 + step), > 0
+  int steps_above = 2;      // Step: steps run above the first collapsing one, >= 0
+  double tolerance = 0.02;  // relative bracket width of the final bisection, in (0, 1)
+};
+
+// The collapse amplitude at one frequency (header comment).
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
-                                   double frequency, double a0, double tolerance,
+                                   double frequency, const AmplitudeSearchOptions& search,
                                    const PulseCriteria& criteria, bool quiet);
 
+// The amplitudes of `runs` that survived above the smallest collapsing one, ascending.
+std::vector<double> stable_above_collapse(const std::vector<PulseResult>& runs);
+
 struct PulseOptions {
-  std::string output;         // -o FILE: HDF5 of the single run
-  std::string series;         // --series FILE.csv: time series of the single run
-  bool curve = false;         // --curve
-  std::vector<double> freqs;  // --freqs F1,F2,... [Hz]
-  std::string csv;            // --csv FILE (curve; default curve.csv)
-  std::string plot;           // --plot FILE.png (curve, by scripts/plot_curve)
-  double lambda_star = -1.0;  // --lambda-star X: skip the capacity search (< 0: compute)
-  double tolerance = 0.02;    // --tolerance: relative bracket width on A
-  int points = 2;             // --points: capacity trials per round
+  std::string output;           // -o FILE: HDF5 of the single run
+  std::string series;           // --series FILE.csv: time series of the single run
+  bool curve = false;           // --curve
+  std::vector<double> freqs;    // --freqs F1,F2,... [Hz]
+  std::string csv;              // --csv FILE (curve; default curve.csv)
+  std::string plot;             // --plot FILE.png (curve, by scripts/plot_curve)
+  double lambda_star = -1.0;    // --lambda-star X: skip the capacity search (< 0: compute)
+  double tolerance = 0.02;      // --tolerance: relative bracket width on A
+  int points = 2;               // --points: capacity trials per round
+  std::string search = "step";  // --search step|bisect (AmplitudeSearch)
+  double start = 0.0;           // --start A [g] (not given: lambda*/peak factor; bisect: lambda*)
+  bool start_given = false;
+  double step = 0.05;           // --step: relative amplitude step of the stepping search
+  int steps_above = 2;          // --steps-above N: steps past the first collapse
+  double free_time = 1.5;       // --free-time S: PulseCriteria::free_time [s]
+  double tilt_reference = 0.0;  // --tilt-reference X: a measured tilting capacity to compare
+  bool tilt_reference_given = false;
 };
+
+// Checks the options (the curve's search and frequencies with --curve): DeckError (exit 2)
+// naming the option, the value and what is allowed.
+void validate_pulse_options(const PulseOptions& opts);
 
 int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts);
 

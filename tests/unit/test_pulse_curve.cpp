@@ -23,7 +23,7 @@ TEST(PulseCurve, RigidBlockCollapseAmplitudes) {
   const std::string cmd = std::string(VOUSSOIR_BINARY) + " pulse " + VOUSSOIR_SOURCE_DIR +
                           "/cases/block.toml -q --set mesh.size=0.5 --set material.young=1e9"
                           " --set load.base.signal=\\\"windowed_sine\\\" --curve --freqs 4,2"
-                          " --lambda-star 0.5 --threads 2 --csv " +
+                          " --lambda-star 0.5 --search bisect --threads 2 --csv " +
                           csv + " --json " + json + " > /dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   std::ifstream in(json);
