@@ -204,6 +204,16 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   if (lambda_star < 0.0) {
     if (!common.quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
     const CapacityResult cap = find_capacity(config, crit.settle, opts.points, common.quiet);
+    // Without a collapse there is no tilting capacity, hence no quasi-static limit to start
+    // the curve from or to compare it with.
+    if (!cap.bracketed) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "the tilting capacity search found %s = %.4f: no quasi-static limit for the "
+                    "curve (give one with --lambda-star)",
+                    kNoCollapse, cap.lo);
+      throw RunError(buf);
+    }
     lambda_star = cap.lambda_star;
     capacity_wall = cap.wall_s;
     if (!common.quiet)
