@@ -152,6 +152,9 @@ int main(int argc, char** argv) {
                     "relative amplitude step of --search step (default 0.05: 5% a step)");
   pulse->add_option("--steps-above", pulse_opts.steps_above,
                     "steps run past the first collapse, to find survivals above it (default 2)");
+  pulse->add_option("--resume", pulse_opts.resume,
+                    "curve: journal of finished runs (and FILE.capacity of the tilting "
+                    "capacity): created, or resumed after a kill");
   pulse->add_option("--free-time", pulse_opts.free_time,
                     "free motion after the signal before an undecided run is classified by its "
                     "trend [s] (default 1.5)");

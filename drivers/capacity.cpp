@@ -162,17 +162,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   return r;
 }
 
-namespace {
-
-void report(const TrialResult& r, bool quiet, bool resumed) {
-  if (quiet) return;
-  std::fprintf(stderr, "  lambda = %.5f  %-9s (%s, %.3f s simulated, %lld steps, %.2f s wall)%s\n",
-               r.lambda, r.collapsed ? "collapsed" : "stable", r.reason.c_str(), r.sim_time,
-               r.steps, r.wall_s, resumed ? " [journal]" : "");
-}
-
-// The journal's fingerprint (core/fnv.hpp) of a settled state and the trial criteria.
-std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
+std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
   Fnv f;
   const Nodes& n = s.sim.model.nodes;
   f.array(n.x);
@@ -187,7 +177,22 @@ std::string fingerprint(const SettledState& s, const TrialCriteria& c) {
     f.value(s.sim.ctx.local_damping_outgoing ? 1.0 : 0.0);
   }
   if (c.direction != 1.0) f.value(c.direction);
+  // The contact law: the settled positions need not show a change of friction or joint
+  // stiffness (a block at rest under gravity alone sits the same at any friction).
+  const ContactParams& cp = s.sim.contact.params();
+  for (double v : {cp.penalty, cp.friction, cp.normal_stiffness, cp.joint_young,
+                   cp.shear_stiffness, cp.restitution})
+    f.value(v);
   return f.hex();
+}
+
+namespace {
+
+void report(const TrialResult& r, bool quiet, bool resumed) {
+  if (quiet) return;
+  std::fprintf(stderr, "  lambda = %.5f  %-9s (%s, %.3f s simulated, %lld steps, %.2f s wall)%s\n",
+               r.lambda, r.collapsed ? "collapsed" : "stable", r.reason.c_str(), r.sim_time,
+               r.steps, r.wall_s, resumed ? " [journal]" : "");
 }
 
 nlohmann::json trial_json(const TrialResult& r) {
@@ -272,7 +277,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   res.triangles = settled.sim.model.tris.size();
   res.dt = settled.sim.ctx.dt;
   if (!settled.settled) throw RunError(unsettled_message(settled, crit));
-  Journal journal(search.journal, fingerprint(settled, crit));
+  Journal journal(search.journal, settled_fingerprint(settled, crit));
 
   // Runs the lambdas not in the journal (in parallel when cores allow); returns all results
   // in input order.

@@ -95,6 +95,10 @@ Model mirror_x(const Model& model);
 // Why a settle did not end at rest, for the error of the commands that need rest.
 std::string unsettled_message(const SettledState& settled, const TrialCriteria& criteria);
 
+// The journals' fingerprint (core/fnv.hpp, drivers/journal.hpp) of a settled state and the
+// trial criteria: what a trial's result depends on besides its load.
+std::string settled_fingerprint(const SettledState& settled, const TrialCriteria& criteria);
+
 // One trial from a copy of the settled state; unless quiet, a progress line on stderr every
 // kProgressPeriod of wall time.
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria,

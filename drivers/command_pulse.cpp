@@ -76,6 +76,9 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
                     "(windowed_sine, sine_pulse or file)");
   const SettledState settled = settle(config, crit.settle, common.quiet);
   if (!settled.settled) throw RunError(unsettled_message(settled, crit.settle));
+  // Resume: every run of the curve in a journal (drivers/pulse.hpp find_collapse_amplitude).
+  Journal journal(opts.resume, pulse_fingerprint(settled, config.load.base, crit));
+  Journal* runs_journal = opts.resume.empty() ? nullptr : &journal;
   const std::vector<ControlPoint> points = find_control_points(settled.sim.model);
 
   const std::string out_path = opts.output.empty() ? config.output.file : opts.output;
@@ -203,7 +206,11 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   double capacity_wall = 0.0;
   if (lambda_star < 0.0) {
     if (!common.quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
-    const CapacityResult cap = find_capacity(config, crit.settle, opts.points, common.quiet);
+    CapacitySearch capacity_search;
+    capacity_search.points = opts.points;
+    capacity_search.quiet = common.quiet;
+    if (!opts.resume.empty()) capacity_search.journal = opts.resume + ".capacity";
+    const CapacityResult cap = find_capacity(config, crit.settle, capacity_search);
     // Without a collapse there is no tilting capacity, hence no quasi-static limit to start
     // the curve from or to compare it with.
     if (!cap.bracketed) {
@@ -234,6 +241,9 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
 
   const SettledState settled = settle(config, crit.settle, common.quiet);
   if (!settled.settled) throw RunError(unsettled_message(settled, crit.settle));
+  // Resume: every run of the curve in a journal (drivers/pulse.hpp find_collapse_amplitude).
+  Journal journal(opts.resume, pulse_fingerprint(settled, config.load.base, crit));
+  Journal* runs_journal = opts.resume.empty() ? nullptr : &journal;
 
   // The costliest frequencies first for the dynamic schedule: for the bisection the lowest (the
   // longest pulses), for the stepping search the highest (the most steps from the quasi-static
@@ -254,7 +264,8 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
     const int i = order[k];
     try {
       points[i] =
-          find_collapse_amplitude(settled, config.load.base, freqs[i], search, crit, common.quiet);
+          find_collapse_amplitude(settled, config.load.base, freqs[i], search, crit, common.quiet,
+                                  runs_journal);
     } catch (const std::exception& e) {
       errors[i] = e.what();
       points[i].frequency = freqs[i];

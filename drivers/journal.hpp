@@ -1,5 +1,6 @@
 #pragma once
-// The one journal format (capacity's trials, sweep's cells): a file of JSON lines, the first
+// The one journal format (capacity's trials, sweep's cells, stability's cells, the pulse
+// curve's runs: `--resume FILE` of each command): a file of JSON lines, the first
 // {"fingerprint": "<16 hex digits>"} (core/fnv.hpp over what the records depend on), then one
 // record a line, appended and flushed as each finishes, so a killed command resumes from the
 // records already there. A journal of another fingerprint is refused, never mixed; a line cut

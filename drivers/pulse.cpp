@@ -2,6 +2,8 @@
 
 #include "drivers/pulse.hpp"
 
+#include "core/fnv.hpp"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -249,25 +251,103 @@ std::vector<double> stable_above_collapse(const std::vector<PulseResult>& runs) 
   return out;
 }
 
+std::string pulse_fingerprint(const SettledState& settled, const BaseConfig& base,
+                              const PulseCriteria& crit) {
+  Fnv f;
+  f.text(settled_fingerprint(settled, crit.settle));
+  f.text(base.signal);
+  f.value(base.cycles);
+  f.value(base.band[0]);
+  f.value(base.band[1]);
+  for (double v : {crit.fall_displacement, crit.fall_rotation, crit.rest_speed, crit.hold_time,
+                   crit.free_time, crit.sample_time})
+    f.value(v);
+  return f.hex();
+}
+
+nlohmann::json pulse_run_record(const PulseResult& r) {
+  return {{"frequency", r.frequency},
+          {"amplitude", r.amplitude_g},
+          {"signal_duration", r.signal_duration},
+          {"collapsed", r.collapsed},
+          {"reason", r.reason},
+          {"decided_at", r.decided_at},
+          {"steps", r.steps},
+          {"wall_s", r.wall_s},
+          {"max_kinetic_energy", r.max_kinetic_energy},
+          {"energy_balance_error", r.energy_balance_error},
+          {"max_energy_balance_error", r.max_energy_balance_error},
+          {"pulse_energy_balance_error", r.pulse_energy_balance_error},
+          {"peak_energy", r.peak_energy},
+          {"max_displacement", r.max_displacement},
+          {"max_rotation", r.max_rotation},
+          {"residual_displacement", r.residual_displacement},
+          {"residual_rotation", r.residual_rotation},
+          {"hinges", hinges_record(r.hinges)}};
+}
+
+PulseResult pulse_run_from_record(const nlohmann::json& j) {
+  PulseResult r;
+  r.frequency = j.at("frequency");
+  r.amplitude_g = j.at("amplitude");
+  r.signal_duration = j.at("signal_duration");
+  r.collapsed = j.at("collapsed");
+  r.reason = j.at("reason");
+  r.decided_at = j.at("decided_at");
+  r.steps = j.at("steps");
+  r.wall_s = j.at("wall_s");
+  r.max_kinetic_energy = j.at("max_kinetic_energy");
+  r.energy_balance_error = j.at("energy_balance_error");
+  r.max_energy_balance_error = j.at("max_energy_balance_error");
+  r.pulse_energy_balance_error = j.at("pulse_energy_balance_error");
+  r.peak_energy = j.at("peak_energy");
+  r.max_displacement = j.at("max_displacement");
+  r.max_rotation = j.at("max_rotation");
+  r.residual_displacement = j.at("residual_displacement");
+  r.residual_rotation = j.at("residual_rotation");
+  r.hinges = hinges_from_record(j.at("hinges"));
+  return r;
+}
+
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
                                    double frequency, const AmplitudeSearchOptions& search,
-                                   const PulseCriteria& crit, bool quiet) {
+                                   const PulseCriteria& crit, bool quiet, Journal* journal) {
   const auto wall0 = Clock::now();
   CurvePoint cp;
   cp.frequency = frequency;
   const std::vector<ControlPoint> points = find_control_points(settled.sim.model);
+  // A run of this frequency and amplitude in the journal, or none.
+  auto from_journal = [&](double a, PulseResult& r) {
+    bool found = false;
+#pragma omp critical(pulse_journal)
+    for (const nlohmann::json& j : journal->records())
+      if (j.value("frequency", -1.0) == frequency && j.value("amplitude", -1.0) == a) {
+        r = pulse_run_from_record(j);
+        found = true;
+        break;
+      }
+    return found;
+  };
   auto trial = [&](double a) {
-    const BaseSignal signal = make_base_signal(base, a, frequency, settled.gravity);
-    PulseResult r = run_pulse(settled, signal, 0.0, points, crit);
-    r.amplitude_g = a;
-    r.frequency = frequency;
-    r.control.clear();  // not needed per trial
+    PulseResult r;
+    const bool resumed = journal && from_journal(a, r);
+    if (!resumed) {
+      const BaseSignal signal = make_base_signal(base, a, frequency, settled.gravity);
+      r = run_pulse(settled, signal, 0.0, points, crit);
+      r.amplitude_g = a;
+      r.frequency = frequency;
+      r.control.clear();  // not needed per trial
+      if (journal) {
+#pragma omp critical(pulse_journal)
+        journal->append(pulse_run_record(r));
+      }
+    }
     cp.max_energy_balance_error = std::max(cp.max_energy_balance_error, r.max_energy_balance_error);
     if (!quiet)
       std::fprintf(stderr,
-                   "  f = %6.3f Hz  A = %.5f g  %-9s (%s at t = %.3f s, %lld steps, %.1f s wall)\n",
+                   "  f = %6.3f Hz  A = %.5f g  %-9s (%s at t = %.3f s, %lld steps, %.1f s wall)%s\n",
                    frequency, a, r.collapsed ? "collapsed" : "survived", r.reason.c_str(),
-                   r.decided_at, r.steps, r.wall_s);
+                   r.decided_at, r.steps, r.wall_s, resumed ? " [journal]" : "");
     cp.runs.push_back(r);
     return r.collapsed;
   };

@@ -64,6 +64,7 @@
 #include "core/base_motion.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/journal.hpp"
 
 namespace voussoir {
 
@@ -167,10 +168,23 @@ struct AmplitudeSearchOptions {
   double tolerance = 0.02;  // relative bracket width of the final bisection, in (0, 1)
 };
 
-// The collapse amplitude at one frequency (header comment).
+// The collapse amplitude at one frequency (header comment). With a `journal`
+// (drivers/journal.hpp; `pulse --curve --resume FILE`), a run of the same frequency and
+// amplitude found there is taken from it instead of being run (the searches recompute the same
+// amplitudes bit for bit), and every run is appended as it finishes; safe to share between the
+// frequencies run in parallel.
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
                                    double frequency, const AmplitudeSearchOptions& search,
-                                   const PulseCriteria& criteria, bool quiet);
+                                   const PulseCriteria& criteria, bool quiet,
+                                   Journal* journal = nullptr);
+
+// The journal of a curve's runs: its fingerprint (the settled state, the signal's definition
+// and the classification criteria: what a run at (frequency, amplitude) depends on), and a run
+// as a record and back.
+std::string pulse_fingerprint(const SettledState& settled, const BaseConfig& base,
+                              const PulseCriteria& criteria);
+nlohmann::json pulse_run_record(const PulseResult& run);
+PulseResult pulse_run_from_record(const nlohmann::json& record);
 
 // The amplitudes of `runs` that survived above the smallest collapsing one, ascending.
 std::vector<double> stable_above_collapse(const std::vector<PulseResult>& runs);
@@ -193,6 +207,7 @@ struct PulseOptions {
   double free_time = 1.5;       // --free-time S: PulseCriteria::free_time [s]
   double tilt_reference = 0.0;  // --tilt-reference X: a measured tilting capacity to compare
   bool tilt_reference_given = false;
+  std::string resume;           // --resume FILE: journal of the curve's runs (and FILE.capacity)
 };
 
 // Checks the options (the curve's search and frequencies with --curve): DeckError (exit 2)

@@ -9,11 +9,13 @@
 // About 4 s of CPU (E lowered to 1 GPa, mesh of one element across).
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -65,6 +67,72 @@ TEST(PulseCurve, RigidBlockCollapseAmplitudes) {
   int rows = 0;
   for (std::string line; std::getline(c, line);) rows += !line.empty();
   EXPECT_EQ(rows, 2);
+}
+
+// `pulse --curve --resume`: a curve killed midway (its journal cut after its first few runs)
+// and run again with the same journal gives the same curve as an uninterrupted run, running
+// only the missing runs; a journal of another deck is refused with exit status 1.
+nlohmann::json run_curve(const std::string& dir, const std::string& name,
+                         const std::string& extra) {
+  const std::string json = dir + name + ".json";
+  const std::string cmd = std::string(VOUSSOIR_BINARY) + " pulse " + VOUSSOIR_SOURCE_DIR +
+                          "/cases/block.toml -q --set mesh.size=0.5 --set material.young=1e9"
+                          " --set load.base.signal=\\\"windowed_sine\\\" --curve --freqs 4,2"
+                          " --lambda-star 0.5 --search bisect --threads 2 --csv " +
+                          dir + name + ".csv --json " + json + " " + extra + " > /dev/null";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  std::ifstream in(json);
+  return nlohmann::json::parse(in);
+}
+
+TEST(PulseCurve, ResumedCurveEqualsTheUninterruptedOne) {
+  const std::string dir = ::testing::TempDir();
+  const std::string journal = dir + "curve_resume.journal";
+  std::remove(journal.c_str());
+  const nlohmann::json straight = run_curve(dir, "curve_straight", "--resume " + journal);
+  // Cut the journal after its header and three runs, as a kill would leave it.
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(journal);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  ASSERT_GT(lines.size(), 5u);
+  {
+    std::ofstream out(journal, std::ios::trunc);
+    for (size_t i = 0; i < 4; ++i) out << lines[i] << "\n";
+  }
+  const nlohmann::json resumed = run_curve(dir, "curve_resumed", "--resume " + journal);
+  ASSERT_EQ(resumed.at("curve").size(), straight.at("curve").size());
+  for (size_t i = 0; i < straight.at("curve").size(); ++i) {
+    const auto &a = straight["curve"][i], &b = resumed["curve"][i];
+    EXPECT_EQ(a.at("amplitude"), b.at("amplitude"));
+    EXPECT_EQ(a.at("bracket"), b.at("bracket"));
+    EXPECT_EQ(a.at("trials"), b.at("trials"));
+    for (size_t k = 0; k < a.at("runs").size(); ++k) {
+      EXPECT_EQ(a["runs"][k].at("amplitude"), b["runs"][k].at("amplitude"));
+      EXPECT_EQ(a["runs"][k].at("collapsed"), b["runs"][k].at("collapsed"));
+      EXPECT_EQ(a["runs"][k].at("max_rotation"), b["runs"][k].at("max_rotation"));
+      EXPECT_EQ(a["runs"][k].at("steps"), b["runs"][k].at("steps"));
+    }
+  }
+  // The journal holds every run once: the three kept and the ones run again.
+  size_t records = 0;
+  {
+    std::ifstream in(journal);
+    for (std::string line; std::getline(in, line);) records += !line.empty();
+  }
+  EXPECT_EQ(records, lines.size());
+
+  // Another deck (another friction): refused, the journal kept.
+  const std::string cmd = std::string(VOUSSOIR_BINARY) + " pulse " + VOUSSOIR_SOURCE_DIR +
+                          "/cases/block.toml -q --set mesh.size=0.5 --set material.young=1e9"
+                          " --set contact.friction=0.7"
+                          " --set load.base.signal=\\\"windowed_sine\\\" --curve --freqs 4"
+                          " --lambda-star 0.5 --search bisect --resume " +
+                          journal + " > /dev/null 2>&1";
+  const int status = std::system(cmd.c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status;
+  std::remove(journal.c_str());
 }
 
 }  // namespace
