@@ -181,6 +181,9 @@ struct Reader {
   std::map<std::string, std::string> set_raw;     // dotted key -> raw VALUE of its --set
   std::map<std::string, const toml::node*> seen;  // dotted key -> node, for every key given
   std::string key;                                // dotted key being read
+  // Input-file keys read so far -> the resolved path (input_file), checked once the whole
+  // deck says which of them the run will read.
+  mutable std::map<std::string, std::string> input_files;
 
   bool from_set(const std::string& k) const { return set_raw.count(k) != 0; }
 
@@ -269,6 +272,7 @@ struct Reader {
     if (s.empty()) fail(n, "a file name");
     fs::path p(s);
     if (p.is_relative() && !from_set(key)) p = (fs::path(deck_dir) / p).lexically_normal();
+    input_files[key] = p.string();
     return p.string();
   }
 };
@@ -645,8 +649,16 @@ void check_together(const Reader& r, Config& c) {
                              ": impact damping needs material.model = \"rigid\" (elastic blocks "
                              "allow only 1)"));
   }
-  if (c.model.kind == "polygons") readable("model.file", c.model.file);
-  if (c.load.base.signal == "file") readable("load.base.file", c.load.base.file);
+  // The input files this deck's run reads: its kind's required keys (core/scene_kinds.hpp)
+  // and the accelerogram of a "file" signal. A file key that the run ignores is not opened.
+  std::vector<std::string> reads;
+  for (const RequiredKey& req : kind ? kind->required : std::vector<RequiredKey>{})
+    reads.emplace_back(req.key);
+  if (c.load.base.signal == "file") reads.emplace_back("load.base.file");
+  for (const std::string& key : reads) {
+    const auto it = r.input_files.find(key);
+    if (it != r.input_files.end()) readable(key, it->second);
+  }
   if (given("capacity.lambda_min") && given("capacity.lambda_max") &&
       !(c.capacity.lambda_min == 0.0 && c.capacity.lambda_max == 0.0) &&
       !(c.capacity.lambda_min < c.capacity.lambda_max)) {
