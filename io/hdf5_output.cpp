@@ -509,6 +509,9 @@ void RunWriter::write_snapshot(double time, const Model& model,
     }
     for (std::size_t k = 0; k < parts.size(); ++k)
       s.write_array(group.get(), kStressNames[k], H5T_NATIVE_DOUBLE, T, 0, parts[k].data());
+    // The T x 3 (sxx, syy, sxy) dataset of the earlier layout, kept for readers of the HDF5
+    // file (h5py scripts); the XDMF does not declare it (ParaView would take it for a vector).
+    s.write_array(group.get(), "stress", H5T_NATIVE_DOUBLE, T, 3, stress_xx_yy_xy.data());
   }
   s.snapshot_times.push_back(time);
   s.check(H5Fflush(s.file.get(), H5F_SCOPE_LOCAL), "flush");

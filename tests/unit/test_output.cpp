@@ -293,6 +293,9 @@ TEST(RunWriter, WritesMeshSeriesSnapshotsAndCompletes) {
     const auto xx = read_doubles(f.id, g + "stress_xx"), yy = read_doubles(f.id, g + "stress_yy"),
                xy = read_doubles(f.id, g + "stress_xy"), s_1 = read_doubles(f.id, g + "stress_1"),
                s_2 = read_doubles(f.id, g + "stress_2");
+    // The T x 3 dataset of the earlier layout stays in the HDF5 file, equal to the scalars.
+    EXPECT_EQ(dims_of(f.id, g + "stress"), (std::vector<hsize_t>{3, 3}));
+    EXPECT_EQ(read_doubles(f.id, g + "stress"), st);
     for (std::size_t e = 0; e < 3; ++e) {
       EXPECT_EQ(xx[e], st[3 * e]);
       EXPECT_EQ(yy[e], st[3 * e + 1]);
