@@ -86,7 +86,8 @@ TEST(Thrust, CentreOfPressureMovesByLambdaHalfHeightWeightOverNormal) {
     const JointResultant& j = r.joints[0];
     ASSERT_TRUE(j.closed) << lambda;
     EXPECT_NEAR(j.normal_force, w, 1e-4 * w) << lambda;
-    EXPECT_NEAR(j.shear_force, lambda * w, 1e-4 * w) << lambda;
+    // V: the ground's force on the block along the joint (a -> b is +x) holds back lambda W.
+    EXPECT_NEAR(j.shear_force, -lambda * w, 1e-4 * w) << lambda;
     const double x = lambda * 0.5 * kHeight * w / j.normal_force;
     EXPECT_NEAR(j.point.x, x, 1e-3 * kWidth) << lambda;
     EXPECT_NEAR(j.eccentricity, x / (0.5 * kWidth), 2e-3) << lambda;
