@@ -8,12 +8,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "drivers/capacity.hpp"
 #include "drivers/thrust.hpp"
 #include "io/deck.hpp"
+#include "subprocess.hpp"
 
 namespace voussoir {
 namespace {
@@ -137,6 +141,35 @@ TEST(Thrust, HingeJointsOfTheCollapsedTrialHaveTheirThrustAtAnEdge) {
     EXPECT_EQ(j.eccentricity < 0.0, h.side == "intrados") << "joint " << h.joint;
   }
   EXPECT_GE(hinges, 3);
+}
+
+// Through the program: `run --json` ends with the joints under SPEC.md's names. The shipped
+// block (0.5 x 1 m, elastic) under lambda = 0.3: e = lambda h / b = 0.6 at the end.
+TEST(Thrust, RunJsonCarriesTheJoints) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "voussoir_thrust_cli";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string json = (dir / "run.json").string();
+  const auto r = testing::run_process(
+      {VOUSSOIR_BINARY, "run", std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml", "-q",
+       "--set", "solver.end_time=0.05", "--set", "load.lambda=0.3", "-o", (dir / "run.h5").string(),
+       "--json", json},
+      {}, (dir / "child").string());
+  ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  fs::remove_all(dir);
+  ASSERT_TRUE(j.contains("joints"));
+  ASSERT_EQ(j["joints"].size(), 1u);
+  const nlohmann::json& joint = j["joints"][0];
+  for (const char* key :
+       {"joint", "blocks", "normal_force", "shear_force", "eccentricity", "point"})
+    EXPECT_TRUE(joint.contains(key)) << key;
+  EXPECT_EQ(joint["joint"].get<int>(), 0);
+  const double w = 2000.0 * kWidth * kHeight * 9.81;
+  EXPECT_NEAR(joint["normal_force"].get<double>(), w, 1e-4 * w);
+  EXPECT_NEAR(joint["eccentricity"].get<double>(), 0.3 * kHeight / kWidth, 1e-4);
 }
 
 }  // namespace
