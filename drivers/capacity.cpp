@@ -412,8 +412,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     if (at_lo == 0.0) res.joints_stable = res.joints_settled, res.has_stable = true;
     for (const TrialResult& r : res.trials) {
       if (r.joints.empty()) continue;
-      if (!r.collapsed && r.lambda == at_lo)
-        res.joints_stable = r.joints, res.has_stable = true;
+      if (!r.collapsed && r.lambda == at_lo) res.joints_stable = r.joints, res.has_stable = true;
       if (bracketed && r.collapsed && r.lambda == at_hi)
         res.joints_collapsed = r.joints, res.has_collapsed = true;
     }

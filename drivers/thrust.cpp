@@ -10,19 +10,6 @@ namespace voussoir {
 
 namespace {
 
-// The node of block b whose reference position is nearest to p.
-Index nearest_node(const Model& model, Index b, Vec2 p) {
-  const Block& blk = model.blocks[std::size_t(b)];
-  const Nodes& n = model.nodes;
-  Index best = blk.first_node;
-  double best_d = std::numeric_limits<double>::infinity();
-  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
-    const double d = std::hypot(n.x0[i] - p.x, n.y0[i] - p.y);
-    if (d < best_d) best_d = d, best = i;
-  }
-  return best;
-}
-
 // Mean reference position of the nodes of block b.
 Vec2 reference_centre(const Model& model, Index b) {
   const Block& blk = model.blocks[std::size_t(b)];
@@ -52,12 +39,12 @@ std::vector<JointResultant> joint_resultants(const Model& model,
   std::vector<char> touched(nj, 0);
   std::map<std::pair<Index, Index>, std::vector<int>> by_blocks;
   const Nodes& n = model.nodes;
+  const std::vector<BlockMotion> motions = block_motions(model);
   for (std::size_t j = 0; j < nj; ++j) {
     const Joint& jt = model.joints[j];
     side[j] = model.blocks[std::size_t(jt.block_b)].fixed ? jt.block_a : jt.block_b;
-    const Index ia = nearest_node(model, side[j], jt.a), ib = nearest_node(model, side[j], jt.b);
-    end_a[j] = {n.x[ia], n.y[ia]};
-    end_b[j] = {n.x[ib], n.y[ib]};
+    end_a[j] = move_point(motions[std::size_t(side[j])], jt.a);
+    end_b[j] = move_point(motions[std::size_t(side[j])], jt.b);
     mid[j] = 0.5 * (end_a[j] + end_b[j]);
     by_blocks[{std::min(jt.block_a, jt.block_b), std::max(jt.block_a, jt.block_b)}].push_back(
         int(j));

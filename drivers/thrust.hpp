@@ -16,8 +16,10 @@
 // into a force and a moment), so a block at rest balances them against its loads to the
 // residual of the settle. So
 //     F = sum_i f_i (force of A on B),   M = sum_i (x_i - O) x f_i   about the joint middle O.
-// Joint line at the current configuration: a' and b' are the current positions of the summed
-// block's nodes at the joint's ends a and b (a: the intrados end of arch joints), t = (b' - a')/L,
+// Joint line at the current configuration: a' and b' are the joint's ends a and b (a: the
+// intrados end of arch joints) moved by the best-fit rigid motion of the summed block
+// (drivers/kinematics.hpp; a block's mesh need not have nodes there: a rigid buttress's minimal
+// mesh drops the extrados springing point from its straight top), t = (b' - a')/L,
 // n the unit normal pointing from A into B. Then
 //     N = F . n (compression positive),   V = F . t,
 // and the centre of pressure is the point P = O + s t of the joint line on the line of action
@@ -34,6 +36,7 @@
 
 #include "contact/contact.hpp"
 #include "core/model.hpp"
+#include "drivers/kinematics.hpp"
 
 namespace voussoir {
 

@@ -124,6 +124,32 @@ TEST(Thrust, SemicircularArchUnderGravityThrustInsideAndSpringingsCarryTheWeight
   EXPECT_NEAR(springings, w, 1e-6 * w);
 }
 
+// A rigid buttress's minimal mesh has no node at the extrados end of its springing joint (its
+// straight top loses the point): the joint is still found and closed. Every joint of the
+// buttressed arch carries compression inside its length, and the ground carries everything.
+TEST(Thrust, ButtressedArchUnderGravityEveryJointClosedAndTheGroundCarriesTheWeight) {
+  const Config config = parse_deck(
+      std::string("[model]\nkind = \"buttressed_arch\"\nshape = \"circular\"\nradius = 1.0\n") +
+          "thickness = 0.2\nembrace = 180.0\nvoussoirs = 11\nbuttress_width = 0.8\n" +
+          "base_depth = 3.0\ncourses = 0\n[material]\nmodel = \"rigid\"\n[contact]\n" +
+          "friction = 0.9\n",
+      "buttressed.toml");
+  const SettledState s = settle(config, quasi_static(), true);
+  ASSERT_TRUE(s.settled);
+  const Model& m = s.sim.model;
+  const std::vector<JointResultant> joints = joint_resultants(m, s.sim.contact, s.sim.ctx.dt);
+  double ground = 0.0;
+  for (const JointResultant& j : joints) {
+    ASSERT_TRUE(j.closed) << "joint " << j.joint;
+    EXPECT_GT(j.normal_force, 0.0) << "joint " << j.joint;
+    EXPECT_LT(std::abs(j.eccentricity), 1.0) << "joint " << j.joint;
+    if (m.blocks[std::size_t(j.block_a)].fixed) ground += j.force.y;
+    if (m.blocks[std::size_t(j.block_b)].fixed) ground -= j.force.y;
+  }
+  const double w = free_weight(m, s.gravity);
+  EXPECT_NEAR(ground, w, 1e-6 * w);
+}
+
 TEST(Thrust, HingeJointsOfTheCollapsedTrialHaveTheirThrustAtAnEdge) {
   const CapacityResult r =
       find_capacity(arch_deck({"capacity.tolerance=0.02"}), quasi_static(), 2, true);
