@@ -664,6 +664,29 @@ void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger) {
     s.accumulate<false>(model, dt, ledger);
 }
 
+std::vector<TouchingPair> ContactSystem::pair_forces(const Model& model, double dt) const {
+  std::vector<TouchingPair> out;
+  if (!impl_->ready) return out;
+  ContactSystem copy(*this);  // evaluate moves the slip and impact history: on the copy
+  if (copy.needs_detection(model.nodes)) copy.detect(model);
+  Impl& s = *copy.impl_;
+  PairResult r;
+  for (std::size_t p = 0; p < s.pairs.size(); ++p) {
+    const bool touching = s.params.friction > 0.0 ? s.evaluate<true>(p, model.nodes, dt, r)
+                                                  : s.evaluate<false>(p, model.nodes, dt, r);
+    if (!touching) continue;
+    TouchingPair f;
+    f.tri_c = s.pairs[p].a;
+    f.tri_t = s.pairs[p].b;
+    for (int k = 0; k < 3; ++k) {
+      f.on_c[k] = {r.on_c[k].x, r.on_c[k].y};
+      f.on_t[k] = {r.on_t[k].x, r.on_t[k].y};
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
 double ContactSystem::max_omega_squared(const Model& model) const {
   const Impl& s = *impl_;
   if (!s.ready) return 0.0;

@@ -32,6 +32,14 @@ struct ContactParams {
 
 // Highest contact frequency bound and the damping rate (c/m) of that mode [1/s2, 1/s], for the
 // stable step of core/step.cpp.
+// The contact force of one touching pair at the current configuration, as the contact stage
+// applies it (potential, friction and impact damping parts): on_c[k] on node k (n0, n1, n2) of
+// triangle tri_c, on_t[k] on node k of triangle tri_t [N].
+struct TouchingPair {
+  Index tri_c = 0, tri_t = 0;
+  Vec2 on_c[3], on_t[3];
+};
+
 struct ContactFrequencyBound {
   double omega_squared = 0.0;
   double damping_rate = 0.0;
@@ -57,6 +65,12 @@ class ContactSystem {
   // Narrow phase + friction: adds contact forces into nodes.fx/fy, sets ledger.contact and
   // accumulates ledger.friction_dissipated and ledger.impact_dissipated.
   void add_forces(Model& model, double dt, EnergyLedger& ledger);
+
+  // The force of every touching pair at the current node positions and velocities, in pair
+  // order: what the next add_forces would apply, evaluated on a copy of this system (detection
+  // when needed, then the narrow phase and friction), so the run's state and its forces are
+  // untouched. For reports (drivers/thrust.hpp), never called inside the step.
+  std::vector<TouchingPair> pair_forces(const Model& model, double dt) const;
 
   // Largest effective contact stiffness per unit nodal mass, for the stable time step:
   // omega_max^2 estimate [1/s2].

@@ -152,6 +152,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   r.sim_time = o.time;
   r.steps = o.steps;
   r.energy_balance_error = sim.ledger.balance_error();
+  r.joints = joint_resultants(sim.model, sim.contact, sim.ctx.dt);
   if (r.collapsed) {
     const double tol = kHingeFraction * settled.l_ref;
     r.hinges = find_hinges(sim.model, tol, tol);
@@ -277,6 +278,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   res.triangles = settled.sim.model.tris.size();
   res.dt = settled.sim.ctx.dt;
   if (!settled.settled) throw RunError(unsettled_message(settled, crit));
+  res.joints_settled = joint_resultants(settled.sim.model, settled.sim.contact, settled.sim.ctx.dt);
   Journal journal(search.journal, settled_fingerprint(settled, crit));
 
   // Runs the lambdas not in the journal (in parallel when cores allow); returns all results
@@ -405,8 +407,19 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       lo = std::max(lo, r.lambda);
     }
   }
+  // The joint resultants of the trials at the bracket's ends (CapacityResult).
+  auto keep_joints = [&](double at_lo, double at_hi, bool bracketed) {
+    if (at_lo == 0.0) res.joints_stable = res.joints_settled, res.has_stable = true;
+    for (const TrialResult& r : res.trials) {
+      if (r.joints.empty()) continue;
+      if (!r.collapsed && r.lambda == at_lo) res.joints_stable = r.joints, res.has_stable = true;
+      if (bracketed && r.collapsed && r.lambda == at_hi)
+        res.joints_collapsed = r.joints, res.has_collapsed = true;
+    }
+  };
   res.bracketed = have_hi;
   if (!have_hi) {
+    keep_joints(lo, hi, false);
     res.lo = res.hi = res.lambda_star = lo;
     res.wall_s = seconds_since(t0);
     return res;
@@ -436,6 +449,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       res.mode.nodes.y = r.final_y;
     }
   }
+  keep_joints(lo, hi, true);
   res.lo = lo;
   res.hi = hi;
   res.lambda_star = 0.5 * (lo + hi);

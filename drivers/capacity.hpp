@@ -34,6 +34,7 @@
 
 #include "core/step.hpp"
 #include "drivers/kinematics.hpp"
+#include "drivers/thrust.hpp"
 #include "drivers/trial.hpp"
 #include "core/schema.hpp"
 
@@ -67,6 +68,9 @@ struct TrialResult {
   double energy_balance_error = 0.0;
   std::vector<Hinge> hinges;           // joints opened or slid at the end of the trial
   std::vector<double> final_x, final_y;  // node positions at the end (collapsed trials only)
+  // Joint resultants at the end of the trial (drivers/thrust.hpp); empty for a trial taken
+  // from a journal.
+  std::vector<JointResultant> joints;
 };
 
 struct SettledState {
@@ -146,6 +150,12 @@ struct CapacityResult {
   // that trial ran in this process (not taken from a journal).
   bool has_mode = false;
   Model mode;
+  // Joint resultants (drivers/thrust.hpp): of the settled state under gravity; of the last
+  // stable trial, at lo (the settled state when lo = 0 was not tried); of the collapsed trial
+  // at hi. has_stable / has_collapsed are false when that trial came from a journal or none
+  // exists.
+  std::vector<JointResultant> joints_settled, joints_stable, joints_collapsed;
+  bool has_stable = false, has_collapsed = false;
 };
 
 // Bisection for lambda*; progress lines on stderr unless quiet.

@@ -117,6 +117,10 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
             {"trials_saved", res.seed.used ? res.seed.unseeded_trials -
                                                  static_cast<int>(res.trials.size())
                                            : 0}}}};
+  // The line of thrust (drivers/thrust.hpp): settled, last stable trial, collapsed trial.
+  j["joints"] = joints_json(res.joints_settled);
+  if (res.has_stable) j["joints_stable"] = joints_json(res.joints_stable);
+  if (res.has_collapsed) j["joints_collapsed"] = joints_json(res.joints_collapsed);
   // The highest lambda tried, which stood: the lambda_max of "no collapse up to lambda_max".
   if (!res.bracketed) j["lambda_max"] = res.lo;
   return j;
@@ -128,7 +132,14 @@ void write_mode(const CapacityResult& res, const CapacityOptions& opts) {
     std::fprintf(stderr, "voussoir: no failure-mode picture: %s\n",
                  res.bracketed ? "the collapsed trial came from the journal" : "no collapse found");
   if (!res.has_mode) return;
-  const nlohmann::json mode = failure_mode_json(res.mode, res.hinges);
+  nlohmann::json mode = failure_mode_json(res.mode, res.hinges);
+  // The lines of thrust under gravity and at the last stable lambda (drivers/thrust.hpp).
+  char stable[64];
+  std::snprintf(stable, sizeof stable, "last stable lambda = %.4f", res.lo);
+  mode["thrust"] = nlohmann::json::array();
+  mode["thrust"].push_back({{"label", "gravity"}, {"joints", joints_json(res.joints_settled)}});
+  if (res.has_stable && res.lo > 0.0)
+    mode["thrust"].push_back({{"label", stable}, {"joints", joints_json(res.joints_stable)}});
   if (!opts.mode_out.empty()) write_json(mode, opts.mode_out);
   if (!opts.picture.empty()) {
     const std::string tmp = opts.picture + ".mode.json";

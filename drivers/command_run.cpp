@@ -20,6 +20,7 @@
 #include "drivers/commands.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/thrust.hpp"
 #include "io/checkpoint.hpp"
 #include "io/deck.hpp"
 #include "io/hdf5_output.hpp"
@@ -230,6 +231,8 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
                         {"active_contacts", sim.contact.active_pairs()},
                         {"max_active_contacts", stats.max_active_pairs},
                         {"output", out_path}};
+    // The line of thrust at the end of the run (drivers/thrust.hpp; the run's state untouched).
+    j["joints"] = joints_json(joint_resultants(sim.model, sim.contact, sim.ctx.dt));
     if (checkpoints) j["checkpoint"] = ckpt_path;
     if (!opts.restart.empty()) j["restarted_from"] = opts.restart;
     write_json(j, common.json_path);
