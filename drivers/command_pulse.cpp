@@ -76,9 +76,6 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
                     "(windowed_sine, sine_pulse or file)");
   const SettledState settled = settle(config, crit.settle, common.quiet);
   if (!settled.settled) throw RunError(unsettled_message(settled, crit.settle));
-  // Resume: every run of the curve in a journal (drivers/pulse.hpp find_collapse_amplitude).
-  Journal journal(opts.resume, pulse_fingerprint(settled, config.load.base, crit));
-  Journal* runs_journal = opts.resume.empty() ? nullptr : &journal;
   const std::vector<ControlPoint> points = find_control_points(settled.sim.model);
 
   const std::string out_path = opts.output.empty() ? config.output.file : opts.output;
