@@ -1,5 +1,6 @@
 // `voussoir capacity DECK`: lambda* by k-section bisection, with every trial in the JSON.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -42,8 +43,11 @@ std::string joint_list(const std::vector<Hinge>& hinges, const std::string& kind
 
 std::string failure_mode_text(const CapacityResult& r) {
   if (!r.bracketed) return kNoCollapse;
-  const bool hinging = !joint_list(r.hinges, "hinge").empty();
-  const bool sliding = !joint_list(r.hinges, "sliding").empty();
+  auto any = [&r](const char* kind) {
+    return std::any_of(r.hinges.begin(), r.hinges.end(),
+                       [kind](const Hinge& h) { return h.kind == kind; });
+  };
+  const bool hinging = any("hinge"), sliding = any("sliding");
   if (hinging && sliding) return "hinging and sliding";
   if (hinging) return "hinging";
   if (sliding) return "sliding";
