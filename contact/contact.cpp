@@ -69,17 +69,75 @@ constexpr std::size_t kParallelPairs = 8192;
 // pair's first triangle c, 1 for the second t (the order in which the one-thread loop adds them).
 constexpr int kPairSlots = 6;
 
-// What one pair adds: nodal forces (potential + friction), stored and dissipated energy.
-// Pure output of evaluate (every field written when the pair touches), so not initialised.
+struct XY {
+  double x, y;
+};
+
+// What one pair adds: nodal forces (potential + friction + impact damping), its penalty energy
+// and the energy stored in its slip spring. Pure output of evaluate (every field written when
+// the pair touches), so not initialised.
 struct PairResult {
-  double energy, stored, dissipated;
-  struct {
-    double x, y;
-  } on_c[3], on_t[3];
-  // Impact damping part of on_c/on_t (written only when restitution < 1), for its ledger.
-  struct {
-    double x, y;
-  } damp_c[3], damp_t[3];
+  double energy, stored;
+  XY on_c[3], on_t[3];
+  // Impact damping part of on_c/on_t (written only when restitution < 1), and friction part
+  // (written only when mu > 0), for their ledgers.
+  XY damp_c[3], damp_t[3], fric_c[3], fric_t[3];
+};
+
+// The corners of one pair (c's then t's) to its slots [2 k + side].
+inline void write_slots(double* sx, double* sy, const XY* on_c, const XY* on_t) {
+  for (int k = 0; k < 3; ++k) {
+    sx[2 * k] = on_c[k].x, sy[2 * k] = on_c[k].y;
+    sx[2 * k + 1] = on_t[k].x, sy[2 * k + 1] = on_t[k].y;
+  }
+}
+
+// Adds one pair's slots to the nodes c (its first triangle's) and d that lie in [lo, hi).
+inline void add_slots(Index lo, Index hi, const Index* c, const Index* d, const double* sx,
+                      const double* sy, double* fx, double* fy) {
+  for (int k = 0; k < 3; ++k) {
+    if (c[k] >= lo && c[k] < hi) fx[c[k]] += sx[2 * k], fy[c[k]] += sy[2 * k];
+    if (d[k] >= lo && d[k] < hi) fx[d[k]] += sx[2 * k + 1], fy[d[k]] += sy[2 * k + 1];
+  }
+}
+
+// Adds one pair's corners to the nodes c and d (the one-thread path).
+inline void add_corners(const Index* c, const Index* d, const XY* on_c, const XY* on_t,
+                        double* fx, double* fy) {
+  for (int k = 0; k < 3; ++k) {
+    fx[c[k]] += on_c[k].x;
+    fy[c[k]] += on_c[k].y;
+    fx[d[k]] += on_t[k].x;
+    fy[d[k]] += on_t[k].y;
+  }
+}
+
+// A part of the contact forces whose work the ledger books by the trapezoid of its nodal
+// values at the two ends of each position increment (x^n - x^(n-1) = dt v^(n-1/2)): the impact
+// dashpots and the friction forces. `now` is filled during the step's contact stage, `prev`
+// holds the last step's; the threaded path writes each pair's corners to its slots first.
+struct TrackedForce {
+  std::vector<double> x, y, prev_x, prev_y;  // per node [N]
+  std::vector<double> slot_x, slot_y;        // [kPairSlots p + 2 k + side] [N]
+
+  void reset(std::size_t nodes) {
+    x.assign(nodes, 0.0);
+    y = prev_x = prev_y = x;
+  }
+  // Work of the forces over the last position increment (trapezoid; node order, so independent
+  // of the threads) [J]; then this step's forces become the previous ones.
+  double work_and_shift(const Nodes& n, double dt) {
+    const double* vx = n.vx.data();
+    const double* vy = n.vy.data();
+    double work = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      work += (x[i] + prev_x[i]) * vx[i] + (y[i] + prev_y[i]) * vy[i];
+      prev_x[i] = x[i];
+      prev_y[i] = y[i];
+      x[i] = y[i] = 0.0;
+    }
+    return 0.5 * dt * work;
+  }
 };
 
 }  // namespace
@@ -99,8 +157,12 @@ struct ContactSystem::Impl {
   // and per node the damping force of this and of the last step (for the ledger's trapezoid).
   bool joints = false, damping = false;
   std::vector<double> ep_thick, beta, prev_fn, next_prev_fn, scratch;
-  std::vector<double> fd_x, fd_y, fd_prev_x, fd_prev_y;
-  std::vector<double> slot_dx, slot_dy;  // threaded path: damping part of the corner slots
+  TrackedForce impact;  // the dashpots' nodal forces (when `damping`)
+  // Friction (mu > 0): its nodal forces, and the slip springs' stored energy sum 1/2 k_t s^2
+  // of the last step [J]. The ledger books as dissipated the work the friction forces take
+  // from the blocks minus what their springs store (accumulate).
+  TrackedForce friction;
+  double stored_prev = 0.0;
   // Nodes of each pair's two triangles (c = pairs[p].a, t = pairs[p].b), filled at detection
   // so that the per-step loop reads one flat array per corner instead of pairs -> tris -> nodes.
   std::vector<Index> pc0, pc1, pc2, pt0, pt1, pt2;
@@ -119,7 +181,7 @@ struct ContactSystem::Impl {
   // Threaded path (parallel_pairs candidates and up; a test may lower it).
   std::size_t parallel_pairs = kParallelPairs;
   std::vector<double> slot_fx, slot_fy;      // [kPairSlots p + 2 k + side] [N]
-  std::vector<double> pair_sums;             // [3 p ..]: energy, stored, dissipated [J]
+  std::vector<double> pair_sums;             // [2 p ..]: energy, stored [J]
   std::vector<unsigned char> pair_touching;  // 1 when pair p touches
   // Node range k is [owner_cut[k], owner_cut[k + 1]), one per thread; empty = not yet cut for
   // the current pairs.
@@ -159,8 +221,9 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
   s.ep_thick.clear();
   s.beta.clear();
   s.prev_fn.clear();
-  s.fd_x.assign(s.damping ? model.nodes.x.size() : 0, 0.0);
-  s.fd_y = s.fd_prev_x = s.fd_prev_y = s.fd_x;
+  s.impact.reset(s.damping ? model.nodes.x.size() : 0);
+  s.friction.reset(params.friction > 0.0 ? model.nodes.x.size() : 0);
+  s.stored_prev = 0.0;
   const Participants parts = select_participants(model);
   const double buffer = params.buffer > 0.0 ? params.buffer : default_buffer(model, parts);
   s.broad.setup(model, buffer);
@@ -270,6 +333,7 @@ void ContactSystem::Impl::add_owned(Index lo, Index hi, double* fx, double* fy) 
   auto add = [lo, hi, fx, fy](Index i, double x, double y) {
     if (i >= lo && i < hi) fx[i] += x, fy[i] += y;
   };
+  const bool with_friction = !friction.x.empty();
   for (std::size_t p = 0; p < np; ++p) {
     if (!pair_touching[p]) continue;
     const double* on_x = slot_fx.data() + kPairSlots * p;
@@ -280,38 +344,28 @@ void ContactSystem::Impl::add_owned(Index lo, Index hi, double* fx, double* fy) 
       add(c[k], on_x[2 * k], on_y[2 * k]);
       add(d[k], on_x[2 * k + 1], on_y[2 * k + 1]);
     }
-    if (!damping) continue;
-    const double* d_x = slot_dx.data() + kPairSlots * p;
-    const double* d_y = slot_dy.data() + kPairSlots * p;
-    double* gx = fd_x.data();
-    double* gy = fd_y.data();
-    for (int k = 0; k < 3; ++k) {
-      if (c[k] >= lo && c[k] < hi) gx[c[k]] += d_x[2 * k], gy[c[k]] += d_y[2 * k];
-      if (d[k] >= lo && d[k] < hi) gx[d[k]] += d_x[2 * k + 1], gy[d[k]] += d_y[2 * k + 1];
-    }
+    const std::size_t at = kPairSlots * p;
+    if (damping)
+      add_slots(lo, hi, c, d, impact.slot_x.data() + at, impact.slot_y.data() + at,
+                impact.x.data(), impact.y.data());
+    if (with_friction)
+      add_slots(lo, hi, c, d, friction.slot_x.data() + at, friction.slot_y.data() + at,
+                friction.x.data(), friction.y.data());
   }
 }
 
 // Writes pair p's result to its slots (r == nullptr: the pair does not touch, and its slots are
 // not read).
 void ContactSystem::Impl::store(std::size_t p, const PairResult* r) {
-  double* fx = slot_fx.data() + kPairSlots * p;
-  double* fy = slot_fy.data() + kPairSlots * p;
-  double* sums = pair_sums.data() + 3 * p;
   pair_touching[p] = r != nullptr;
   if (r == nullptr) return;
-  for (int k = 0; k < 3; ++k) {
-    fx[2 * k] = r->on_c[k].x, fy[2 * k] = r->on_c[k].y;
-    fx[2 * k + 1] = r->on_t[k].x, fy[2 * k + 1] = r->on_t[k].y;
-  }
-  sums[0] = r->energy, sums[1] = r->stored, sums[2] = r->dissipated;
-  if (!damping) return;
-  double* dx = slot_dx.data() + kPairSlots * p;
-  double* dy = slot_dy.data() + kPairSlots * p;
-  for (int k = 0; k < 3; ++k) {
-    dx[2 * k] = r->damp_c[k].x, dy[2 * k] = r->damp_c[k].y;
-    dx[2 * k + 1] = r->damp_t[k].x, dy[2 * k + 1] = r->damp_t[k].y;
-  }
+  const std::size_t at = kPairSlots * p;
+  write_slots(slot_fx.data() + at, slot_fy.data() + at, r->on_c, r->on_t);
+  pair_sums[2 * p] = r->energy, pair_sums[2 * p + 1] = r->stored;
+  if (damping)
+    write_slots(impact.slot_x.data() + at, impact.slot_y.data() + at, r->damp_c, r->damp_t);
+  if (!friction.x.empty())
+    write_slots(friction.slot_x.data() + at, friction.slot_y.data() + at, r->fric_c, r->fric_t);
 }
 
 void ContactSystem::Impl::record_detection(const Nodes& nodes) {
@@ -326,11 +380,16 @@ void ContactSystem::Impl::record_detection(const Nodes& nodes) {
 
 // State bytes: u64 tag, u8 ready, u8 detected, i64 detections, i64 active, then the arrays
 // detected_x, detected_y, pairs, sx, sy (each u64 count then the items); from tag 2 on, the
-// impact damping's prev_fn (per pair), fd_prev_x and fd_prev_y (per node), empty without it.
+// impact damping's prev_fn (per pair) and its last nodal forces x and y (per node), empty
+// without it; from tag 3 on, friction's last nodal forces x and y (per node, empty without
+// friction) and its springs' stored energy of the last step (f64). A state of tag 1 or 2 with
+// friction restarts with those at zero and the stored energy of its slips: its first step books
+// the friction work of half a step less than an uninterrupted run (the ledger only).
 namespace {
 
 constexpr std::uint64_t kStateTag1 = 0x564f555353434f31ull;  // "VOUSSCO1": no damping arrays
-constexpr std::uint64_t kStateTag = 0x564f555353434f32ull;   // "VOUSSCO2"
+constexpr std::uint64_t kStateTag2 = 0x564f555353434f32ull;  // "VOUSSCO2": no friction arrays
+constexpr std::uint64_t kStateTag = 0x564f555353434f33ull;   // "VOUSSCO3"
 
 void put_bytes(std::vector<char>& out, const void* p, std::size_t n) {
   const std::size_t at = out.size();
@@ -388,8 +447,11 @@ std::vector<char> ContactSystem::save_state() const {
   put_array(out, s.sx);
   put_array(out, s.sy);
   put_array(out, s.prev_fn);
-  put_array(out, s.fd_prev_x);
-  put_array(out, s.fd_prev_y);
+  put_array(out, s.impact.prev_x);
+  put_array(out, s.impact.prev_y);
+  put_array(out, s.friction.prev_x);
+  put_array(out, s.friction.prev_y);
+  put<double>(out, s.stored_prev);
   return out;
 }
 
@@ -397,23 +459,38 @@ void ContactSystem::restore_state(const Model& model, const std::vector<char>& b
   Impl& s = *impl_;
   StateReader in{bytes};
   const auto tag = in.get<std::uint64_t>();
-  if (tag != kStateTag && tag != kStateTag1) in.fail("not a contact state");
+  if (tag != kStateTag && tag != kStateTag2 && tag != kStateTag1) in.fail("not a contact state");
   const bool ready = in.get<std::uint8_t>() != 0, detected = in.get<std::uint8_t>() != 0;
   const auto detections = in.get<std::int64_t>(), active = in.get<std::int64_t>();
   std::vector<double> dx = in.get_array<double>(), dy = in.get_array<double>();
   std::vector<IndexPair> pairs = in.get_array<IndexPair>();
   std::vector<double> sx = in.get_array<double>(), sy = in.get_array<double>();
-  std::vector<double> prev_fn, fd_prev_x, fd_prev_y;
-  if (tag == kStateTag) {
+  std::vector<double> prev_fn, fd_prev_x, fd_prev_y, ff_prev_x, ff_prev_y;
+  bool has_friction_state = false;
+  double stored_prev = 0.0;
+  if (tag != kStateTag1) {
     prev_fn = in.get_array<double>();
     fd_prev_x = in.get_array<double>();
     fd_prev_y = in.get_array<double>();
   }
+  if (tag == kStateTag) {
+    ff_prev_x = in.get_array<double>();
+    ff_prev_y = in.get_array<double>();
+    stored_prev = in.get<double>();
+    has_friction_state = true;
+  }
   if (in.pos != bytes.size()) in.fail("unexpected data after the state");
-  if (s.damping && (fd_prev_x.size() != s.fd_x.size() || fd_prev_y.size() != s.fd_x.size()))
+  const std::size_t nodes = model.nodes.x.size();
+  if (s.damping && (fd_prev_x.size() != nodes || fd_prev_y.size() != nodes))
     in.fail("written without the impact damping (contact.restitution) of this model");
   if (!s.damping && !fd_prev_x.empty())
     in.fail("written with an impact damping (contact.restitution) this model does not have");
+  const bool friction = !s.friction.x.empty();
+  if (has_friction_state && friction != !ff_prev_x.empty())
+    in.fail(std::string("written ") + (friction ? "without" : "with") + " the friction " +
+            (friction ? "of this model" : "this model does not have") + " (contact.friction)");
+  if (has_friction_state && friction && (ff_prev_x.size() != nodes || ff_prev_y.size() != nodes))
+    in.fail("friction node count differs from the model");
   if (ready != s.ready) in.fail("written with contact " + std::string(ready ? "on" : "off"));
   if (!ready) return;
   const std::vector<Index>& free_nodes = s.broad.participants().free_nodes;
@@ -441,10 +518,21 @@ void ContactSystem::restore_state(const Model& model, const std::vector<char>& b
   if (s.damping) {
     if (prev_fn.size() != s.pairs.size()) in.fail("impact damping and pair counts differ");
     s.prev_fn = std::move(prev_fn);
-    s.fd_prev_x = std::move(fd_prev_x);
-    s.fd_prev_y = std::move(fd_prev_y);
+    s.impact.prev_x = std::move(fd_prev_x);
+    s.impact.prev_y = std::move(fd_prev_y);
   }
   s.index_pairs(model);
+  if (friction) {
+    if (has_friction_state) {
+      s.friction.prev_x = std::move(ff_prev_x);
+      s.friction.prev_y = std::move(ff_prev_y);
+    } else {
+      stored_prev = 0.0;
+      for (std::size_t p = 0; p < s.pairs.size(); ++p)
+        stored_prev += 0.5 * s.kt[p] * (s.sx[p] * s.sx[p] + s.sy[p] * s.sy[p]);
+    }
+    s.stored_prev = stored_prev;
+  }
   s.detected_x = std::move(dx);
   s.detected_y = std::move(dy);
   s.detections = detections;
@@ -517,7 +605,6 @@ template <bool kFriction>
   }
   r.energy = f.energy;
   r.stored = 0.0;
-  r.dissipated = 0.0;
   for (int k = 0; k < 3; ++k) {
     r.on_c[k] = {f.on_c[k].x, f.on_c[k].y};
     r.on_t[k] = {f.on_t[k].x, f.on_t[k].y};
@@ -550,13 +637,17 @@ template <bool kFriction>
     sx[p] = fr.slip.x;
     sy[p] = fr.slip.y;
     for (int k = 0; k < 3; ++k) {
+      const XY c0 = r.on_c[k], t0 = r.on_t[k];
       r.on_c[k].x += wc[k] * fr.force.x;
       r.on_c[k].y += wc[k] * fr.force.y;
       r.on_t[k].x -= wt[k] * fr.force.x;
       r.on_t[k].y -= wt[k] * fr.force.y;
+      // The friction part as it was added (the additions above stay those of the force
+      // path: a product kept for the ledger could change how the compiler fuses them).
+      r.fric_c[k] = {r.on_c[k].x - c0.x, r.on_c[k].y - c0.y};
+      r.fric_t[k] = {r.on_t[k].x - t0.x, r.on_t[k].y - t0.y};
     }
     r.stored = fr.stored;
-    r.dissipated = fr.dissipated;
   }
   return true;
 }
@@ -566,7 +657,7 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
   Nodes& n = model.nodes;
   double* fx = n.fx.data();
   double* fy = n.fy.data();
-  double energy = 0.0, stored = 0.0, dissipated = 0.0;
+  double energy = 0.0, stored = 0.0;
   std::int64_t n_active = 0;
   // Adds one touching pair's result; always called in pair order, so the sums are the same
   // whatever the number of threads that evaluated the pairs.
@@ -574,7 +665,6 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
     ++n_active;
     energy += r.energy;
     stored += r.stored;
-    dissipated += r.dissipated;
     const Index c[3] = {pc0[p], pc1[p], pc2[p]};
     const Index d[3] = {pt0[p], pt1[p], pt2[p]};
     for (int k = 0; k < 3; ++k) {
@@ -583,13 +673,9 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
       fx[d[k]] += r.on_t[k].x;
       fy[d[k]] += r.on_t[k].y;
     }
-    if (!damping) return;
-    for (int k = 0; k < 3; ++k) {
-      fd_x[c[k]] += r.damp_c[k].x;
-      fd_y[c[k]] += r.damp_c[k].y;
-      fd_x[d[k]] += r.damp_t[k].x;
-      fd_y[d[k]] += r.damp_t[k].y;
-    }
+    if (damping) add_corners(c, d, r.damp_c, r.damp_t, impact.x.data(), impact.y.data());
+    if constexpr (kFriction)
+      add_corners(c, d, r.fric_c, r.fric_t, friction.x.data(), friction.y.data());
   };
   const std::size_t np = pairs.size();
   if (np >= parallel_pairs && threads_available()) {
@@ -600,9 +686,13 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
     const std::int64_t count = static_cast<std::int64_t>(np);
     slot_fx.resize(kPairSlots * np);  // every slot read is written first in this step
     slot_fy.resize(kPairSlots * np);
-    pair_sums.resize(3 * np);
+    pair_sums.resize(2 * np);
     pair_touching.resize(np);
-    if (damping) slot_dx.resize(kPairSlots * np), slot_dy.resize(kPairSlots * np);
+    for (TrackedForce* t : {&impact, &friction}) {
+      if (t->x.empty()) continue;
+      t->slot_x.resize(kPairSlots * np);
+      t->slot_y.resize(kPairSlots * np);
+    }
     const int ranges = omp_get_max_threads();
     if (owner_cut.size() != std::size_t(ranges) + 1) cut_owners(n.size(), ranges);
 #pragma omp parallel
@@ -621,9 +711,8 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
         for (std::size_t p = 0; p < np; ++p) {
           if (!pair_touching[p]) continue;
           ++n_active;
-          energy += pair_sums[3 * p];
-          stored += pair_sums[3 * p + 1];
-          dissipated += pair_sums[3 * p + 2];
+          energy += pair_sums[2 * p];
+          stored += pair_sums[2 * p + 1];
         }
       }
     }
@@ -634,20 +723,16 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
   }
   active = n_active;
   ledger.contact = energy + stored;
-  if constexpr (kFriction) ledger.friction_dissipated += dissipated;
-  if (damping) {
-    // Work of the dashpots over the last position increment x^n - x^(n-1) = dt v^(n-1/2), by
-    // the trapezoid of their forces at its two ends (node order: independent of the threads).
-    const double* vx = n.vx.data();
-    const double* vy = n.vy.data();
-    double work = 0.0;
-    for (std::size_t i = 0; i < fd_x.size(); ++i) {
-      work += (fd_x[i] + fd_prev_x[i]) * vx[i] + (fd_y[i] + fd_prev_y[i]) * vy[i];
-      fd_prev_x[i] = fd_x[i];
-      fd_prev_y[i] = fd_y[i];
-      fd_x[i] = fd_y[i] = 0.0;
-    }
-    ledger.impact_dissipated -= 0.5 * dt * work;
+  // The dashpots' work over the last position increment is what they dissipated. Friction
+  // dissipated what its forces took from the blocks less what its slip springs now store
+  // more than at the last step. Both works by the trapezoid of the nodal forces at the two
+  // ends of the increment: the rule by which the central-difference kinetic energy changes, so
+  // the balance closes whatever the contacts do within a step (stick, slip, reversal, release
+  // of a spring whose pair opens).
+  if (damping) ledger.impact_dissipated -= impact.work_and_shift(n, dt);
+  if constexpr (kFriction) {
+    ledger.friction_dissipated -= friction.work_and_shift(n, dt) + (stored - stored_prev);
+    stored_prev = stored;
   }
 }
 
