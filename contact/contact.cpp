@@ -727,11 +727,15 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
   // dissipated what its forces took from the blocks less what its slip springs now store
   // more than at the last step. Both works by the trapezoid of the nodal forces at the two
   // ends of the increment: the rule by which the central-difference kinetic energy changes, so
-  // the balance closes whatever the contacts do within a step (stick, slip, reversal, release
-  // of a spring whose pair opens).
+  // the balance closes whatever the contacts do within a step (stick, slip, release of a spring
+  // whose pair opens). Friction cannot give energy back: a step whose friction forces added
+  // more than their springs released (a spring reversing while its cap falls, at a large
+  // step) books nothing, and the excess stays in the balance error, where the scheme's errors
+  // belong.
   if (damping) ledger.impact_dissipated -= impact.work_and_shift(n, dt);
   if constexpr (kFriction) {
-    ledger.friction_dissipated -= friction.work_and_shift(n, dt) + (stored - stored_prev);
+    const double taken = -friction.work_and_shift(n, dt) - (stored - stored_prev);
+    if (taken > 0.0) ledger.friction_dissipated += taken;
     stored_prev = stored;
   }
 }

@@ -22,8 +22,8 @@
 //
 // Ledger. The contact stage does not book that plastic work: it books as dissipated the work
 // the friction forces take from the blocks (trapezoid of their nodal values at the two ends of
-// each position increment) less the change of the springs' stored energy (contact/contact.cpp
-// accumulate). Both agree in steady sliding and stick. They differ at the events an explicit
+// each position increment) less the change of the springs' stored energy, when positive
+// (contact/contact.cpp accumulate). Both agree in steady sliding and stick. They differ at the events an explicit
 // step cannot resolve: the cap mu |F_n| moving while the pair slides (a chattering joint), a
 // spring reversing or released when its pair opens, the overlap centroid moving between
 // steps. The plastic-work form then drifts O(dt): 2.8% of the peak energy in 0.01 s on church A

@@ -64,14 +64,16 @@ void prepare_context(Simulation& sim, double damping_factor) {
 //
 // Rigid blocks have no element modes: the bound is the contact one over the bodies' mass and
 // rotational inertia (contact/contact.hpp rigid_frequency_bound), and the damping rate that of
-// the contact's impact damping (restitution < 1), if any, times kRigidStepFraction
-// (core/rigid.hpp: the joints' one-sided contact must be resolved, not only kept stable).
+// the contact's impact damping (restitution < 1), if any, times kRigidStepFraction, or
+// kRigidDampedStepFraction with impact damping (core/rigid.hpp: the joints' one-sided contact
+// and their dashpots must be resolved, not only kept stable).
 double stable_time_step(const Simulation& sim) {
   if (sim.model.is_rigid()) {
     const ContactFrequencyBound c =
         sim.ctx.contact_on ? sim.contact.rigid_frequency_bound(sim.model) : ContactFrequencyBound{};
     if (!(c.omega_squared > 0.0)) return std::numeric_limits<double>::infinity();
-    return kRigidStepFraction * damped_stable_step(c.omega_squared, c.damping_rate);
+    const double fraction = c.damping_rate > 0.0 ? kRigidDampedStepFraction : kRigidStepFraction;
+    return fraction * damped_stable_step(c.omega_squared, c.damping_rate);
   }
   const CstFrequencyBound el = max_frequency_bound(sim.model, law_of(sim.ctx));
   double omega_squared = el.omega_squared;
