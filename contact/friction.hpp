@@ -28,8 +28,9 @@
 // spring reversing or released when its pair opens, the overlap centroid moving between
 // steps. The plastic-work form then drifts O(dt): 2.8% of the peak energy in 0.01 s on church A
 // with rigid blocks, 1.7% in 0.2 s on the rigid semicircular arch, both undamped joints
-// (restitution 1); the work form closes the balance to the integrator's own error (1.9e-4 and
-// 6.1e-4, falling 4 to 10 times at half the step) and changes no force (docs/rigid.md).
+// (restitution 1), at the rigid step fraction 0.2; the work form closes the balance to the
+// integrator's own error (1.9e-4 and 6.1e-4 there, falling 4 to 5 times at half the step) and
+// changes no force (docs/rigid.md, "Friction in the energy ledger").
 //
 // Tangential stiffness. k_t = kTangentialStiffnessRatio x Ep thick (3/h_c + 3/h_t) min(L_c, L_t)
 // [N/m], with L the longest boundary edge of a triangle and h its height over that edge:
