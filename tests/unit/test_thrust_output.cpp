@@ -1,8 +1,8 @@
 // The line of thrust in the outputs (issue 20; docs/thrust.md): the joint resultants of every
 // snapshot of `voussoir run`'s HDF5 file are those of `run --json` at the final snapshot,
-// value for value; RunWriter refuses a non-finite resultant other than an open joint's; and
+// value for value; RunWriter refuses a non-finite resultant other than an open joint's;
 // `voussoir capacity --movie` writes a GIF of the collapsed trial (scripts/animate, matplotlib
-// and Pillow: installed by scripts/install-deps).
+// and Pillow: installed by scripts/install-deps); run and capacity --picture write a PNG.
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -70,6 +70,14 @@ double snapshot_attribute(hid_t file, const std::string& group, const char* name
   return v;
 }
 
+// The first n bytes of a file.
+std::string magic_of(const std::string& path, std::size_t n) {
+  std::ifstream in(path, std::ios::binary);
+  std::string out(n, '\0');
+  in.read(out.data(), std::streamsize(n));
+  return out.substr(0, std::size_t(in.gcount()));
+}
+
 // The rigid semicircular arch released under gravity and lambda = 0.2 for 0.05 s, a snapshot
 // every 0.01 s: the last snapshot is the end of the run, the state of run --json's "joints".
 TEST(ThrustOutput, RunHdf5JointsAreTheJsonJointsAtTheFinalSnapshot) {
@@ -78,9 +86,11 @@ TEST(ThrustOutput, RunHdf5JointsAreTheJsonJointsAtTheFinalSnapshot) {
   const auto r = testing::run_process(
       {VOUSSOIR_BINARY, "run", source("cases/circular_arch.toml"), "-q", "--set",
        "material.model=rigid", "--set", "solver.end_time=0.05", "--set", "output.every=0.01",
-       "--set", "load.lambda=0.2", "-o", h5, "--json", json},
+       "--set", "load.lambda=0.2", "-o", h5, "--json", json, "--picture",
+       (dir / "end.png").string()},
       {}, (dir / "child").string());
   ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
+  EXPECT_EQ(magic_of((dir / "end.png").string(), 8), "\x89PNG\r\n\x1a\n");  // run --picture
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
   const nlohmann::json& joints = j.at("joints");
@@ -168,17 +178,17 @@ TEST(ThrustOutput, WriterRefusesNonFiniteResultantsAndWrongSizes) {
 TEST(ThrustOutput, CapacityMovieWritesAGifOfTheCollapsedTrial) {
   const fs::path dir = scratch_dir();
   const std::string gif = (dir / "block.gif").string();
+  const std::string png = (dir / "mode.png").string();
   const auto r = testing::run_process({VOUSSOIR_BINARY, "capacity", source("cases/block.toml"),
-                                       "-q", "--set", "material.model=rigid", "--movie", gif},
+                                       "-q", "--set", "material.model=rigid", "--movie", gif,
+                                       "--picture", png},
                                       {}, (dir / "child").string());
   ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
   ASSERT_TRUE(fs::exists(gif)) << r.out << r.err;
   EXPECT_GT(fs::file_size(gif), 10000u);
-  std::ifstream in(gif, std::ios::binary);
-  char magic[6] = {};
-  in.read(magic, 6);
-  EXPECT_EQ(std::string(magic, 6), "GIF89a");
+  EXPECT_EQ(magic_of(gif, 6), "GIF89a");
   EXPECT_NE(r.out.find("movie " + gif), std::string::npos) << r.out;
+  EXPECT_EQ(magic_of(png, 8), "\x89PNG\r\n\x1a\n");
   EXPECT_FALSE(fs::exists(gif + ".+x.h5"));
   EXPECT_FALSE(fs::exists(gif + ".+x.xdmf"));
 
