@@ -133,7 +133,7 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
 }
 
 // The failure-mode JSON and picture of the governing search.
-void write_mode(const CapacityResult& res, const CapacityOptions& opts) {
+void write_mode(const CapacityResult& res, const CapacityOptions& opts, const std::string& deck) {
   if ((!opts.mode_out.empty() || !opts.picture.empty()) && !res.has_mode)
     std::fprintf(stderr, "voussoir: no failure-mode picture: %s\n",
                  res.bracketed ? "the collapsed trial came from the journal" : "no collapse found");
@@ -150,8 +150,8 @@ void write_mode(const CapacityResult& res, const CapacityOptions& opts) {
   if (!opts.mode_out.empty()) write_json(mode, opts.mode_out);
   if (!opts.picture.empty()) {
     char title[160];
-    std::snprintf(title, sizeof title, "lambda* = %.4f, bracket [%.4f, %.4f]", res.lambda_star,
-                  res.lo, res.hi);
+    std::snprintf(title, sizeof title, "%s: lambda* = %.4f, bracket [%.4f, %.4f]",
+                  std::filesystem::path(deck).stem().c_str(), res.lambda_star, res.lo, res.hi);
     draw_geometry(mode, opts.picture, {"--no-mesh", "--title", title});
   }
 }
@@ -162,14 +162,15 @@ std::string movie_h5(const CapacityOptions& opts, const std::string& d) {
 }
 
 // --movie: the recorded trial of the governing search drawn by scripts/animate.
-void write_movie(const CapacityResult& res, const CapacityOptions& opts, const std::string& h5) {
+void write_movie(const CapacityResult& res, const CapacityOptions& opts, const std::string& h5,
+                 const std::string& deck) {
   if (!res.has_movie) {
     std::fprintf(stderr, "voussoir: no movie: no collapse found\n");
     return;
   }
   char label[160];
-  std::snprintf(label, sizeof label, "capacity trial at the upper bound of lambda* = %.4f",
-                res.lambda_star);
+  std::snprintf(label, sizeof label, "%s: capacity trial at the upper bound of lambda* = %.4f",
+                std::filesystem::path(deck).stem().c_str(), res.lambda_star);
   if (draw_with_script("animate", {h5, "-o", opts.movie, "--label", label}, opts.movie))
     std::printf("movie %s: %d frames, %.3f s of the trial (collapse criterion at %.3f s)\n",
                 opts.movie.c_str(), res.movie.frames, res.movie.duration,
@@ -223,9 +224,10 @@ int command_capacity(const Config& config, const CommonOptions& common,
   if (results.size() > 1)
     std::printf("governing direction %s: lambda* = %.4f\n", directions[governing].c_str(),
                 results[governing].lambda_star);
-  write_mode(results[governing], opts);
+  write_mode(results[governing], opts, config.deck_path);
   if (!opts.movie.empty()) {
-    write_movie(results[governing], opts, movie_h5(opts, directions[governing]));
+    write_movie(results[governing], opts, movie_h5(opts, directions[governing]),
+                config.deck_path);
     for (const std::string& d : directions) {
       std::remove(movie_h5(opts, d).c_str());
       std::remove(xdmf_path_for(movie_h5(opts, d)).c_str());
