@@ -20,7 +20,9 @@
 //                                  active_contacts (int64), energy_balance_error [-]
 //   /series/control_displacement   R x C  (only if records carry control displacements;
 //                                  C fixed by the first record; attribute columns)
-//   /snapshots/NNNNNN/     attribute time [s]; datasets of the requested `fields`:
+//   /snapshots/NNNNNN/     attribute time [s] (simulation time; in the file of `capacity
+//                          --movie`, time since the start of the lambda ramp); datasets of
+//                          the requested `fields`:
 //                            position: position (N x 2) [m] and displacement (N x 3: ux,
 //                              uy, 0; position minus /mesh/nodes) [m],
 //                            velocity: velocity (N x 3: vx, vy, 0) [m/s],

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/capacity.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/thrust.hpp"
 #include "io/deck.hpp"
@@ -197,6 +198,48 @@ TEST(ThrustOutput, CapacityMovieWritesAGifOfTheCollapsedTrial) {
                                         {}, (dir / "child2").string());
   EXPECT_TRUE(bad.exited && bad.status == 2) << bad.describe() << bad.err;
   EXPECT_NE(bad.err.find(".gif or .mp4"), std::string::npos) << bad.err;
+  fs::remove_all(dir);
+}
+
+// The movie is the trial: re-run from the settled state, the collapsed trial at the upper
+// bound fires its collapse criterion at the same time as in the search, then goes on to the
+// movie's end (a block rotated kMovieRotation or moved kMovieDisplacement x L_ref); every
+// frame has its resultants and the ramped lambda.
+TEST(ThrustOutput, MovieTrialCollapsesWhenTheSearchedTrialDid) {
+  const fs::path dir = scratch_dir();
+  const Config config = parse_deck(
+      "[model]\nkind = \"block\"\nwidth = 0.5\nheight = 1.0\n[material]\nmodel = \"rigid\"\n"
+      "[contact]\nfriction = 0.8\n",
+      "block.toml");
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  CapacitySearch search;
+  search.quiet = true;
+  search.movie = (dir / "movie.h5").string();
+  const CapacityResult r = find_capacity(config, crit, search);
+  ASSERT_TRUE(r.bracketed);
+  ASSERT_TRUE(r.has_movie);
+  double searched = -1.0;
+  for (const TrialResult& t : r.trials)
+    if (t.collapsed && t.lambda == r.hi) searched = t.sim_time;
+  EXPECT_TRUE(r.movie.collapsed);
+  EXPECT_EQ(r.movie.collapse_time, searched);
+  EXPECT_GT(r.movie.duration, r.movie.collapse_time);
+  EXPECT_GE(r.movie.frames, 40);
+  EXPECT_LE(r.movie.frames, kMovieFrames);
+
+  const hid_t f = H5Fopen(search.movie.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  char name[64];
+  std::snprintf(name, sizeof name, "/snapshots/%06d", r.movie.frames - 1);
+  EXPECT_EQ(snapshot_attribute(f, name, "lambda"), r.hi);  // the ramp is over
+  EXPECT_EQ(snapshot_attribute(f, name, "time"), r.movie.duration);
+  EXPECT_EQ(snapshot_attribute(f, "/snapshots/000000", "lambda"), 0.0);  // the ramp starts
+  const auto ecc =
+      read_dataset<double>(f, std::string(name) + "/joints/eccentricity", H5T_NATIVE_DOUBLE);
+  H5Fclose(f);
+  ASSERT_EQ(ecc.size(), 1u);
+  EXPECT_GT(ecc[0], 0.99);  // overturning about its toe
   fs::remove_all(dir);
 }
 
