@@ -65,6 +65,8 @@ int main(int argc, char** argv) {
                   "checkpoint file (default OUTPUT.ckpt, or DECKNAME.ckpt without output)");
   run->add_option("--restart", run_opts.restart,
                   "continue the run saved in this checkpoint (same deck)");
+  run->add_option("--picture", run_opts.picture,
+                  "picture (PNG/SVG) of the final state with its line of thrust");
 
   voussoir::CapacityOptions cap_opts;
   CLI::App* capacity =
@@ -84,6 +86,8 @@ int main(int argc, char** argv) {
                        "JSON of the deformed collapse state with its hinges");
   capacity->add_option("--picture", cap_opts.picture,
                        "picture (PNG/SVG) of the failure mode with hinges marked");
+  capacity->add_option("--movie", cap_opts.movie,
+                       "movie (GIF, or MP4 with ffmpeg) of the collapsed trial at the upper bound");
   // Trial criteria (defaults and their study: docs/capacity.md).
   capacity->add_option("--ramp-time", cap_opts.criteria.ramp_time, "load ramp [s]")
       ->check(CLI::PositiveNumber);

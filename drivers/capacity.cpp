@@ -18,6 +18,7 @@
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/trial.hpp"
+#include "io/hdf5_output.hpp"
 #include "limit/limit_analysis.hpp"
 
 namespace voussoir {
@@ -106,16 +107,16 @@ std::string unsettled_message(const SettledState& s, const TrialCriteria& crit) 
   return buf;
 }
 
-TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& crit,
-                      bool quiet) {
-  const auto t0 = Clock::now();
-  Simulation sim = settled.sim;  // deep copy
+namespace {
+
+// The run of one trial from a copy of `settled`: lambda g ramped on from the settled state,
+// motions measured from there; collapse at any time, rest and the trend at the time limit
+// once the ramp is over.
+RunSpec trial_spec(const SettledState& settled, double lambda, const TrialCriteria& crit,
+                   bool quiet) {
   const double g = settled.gravity;
   const double v_rest = crit.rest_speed * std::sqrt(std::max(g, 1e-12) * settled.l_ref);
   const double d_collapse = crit.collapse_displacement * settled.l_ref;
-
-  // lambda g ramped on from the settled state; motions measured from there. Collapse at any
-  // time; rest and the trend at the time limit once the ramp is over.
   char label[64];
   std::snprintf(label, sizeof label, "the capacity trial lambda = %.6g", lambda);
   RunSpec spec;
@@ -124,7 +125,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   spec.loads->gravity = g;
   spec.loads->lambda = crit.direction * lambda;
   spec.loads->lambda_ramp = crit.ramp_time;
-  spec.loads->start = sim.ctx.time;
+  spec.loads->start = settled.sim.ctx.time;
   spec.limits = crit.limits;
   spec.track_motion = true;
   spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
@@ -132,15 +133,26 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   spec.rules.push_back(std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0,
                                                    crit.ramp_time, crit.max_time));
   spec.quiet = quiet;
-  spec.progress = [&](const Probe& p, double wall) {
+  const double rot_limit = crit.collapse_rotation;
+  spec.progress = [lambda, d_collapse, v_rest, rot_limit](const Probe& p, double wall) {
     std::fprintf(stderr,
                  "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
                  "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
                  lambda, p.time,
                  100.0 * std::max(p.motion.displacement / d_collapse,
-                                  p.motion.rotation / crit.collapse_rotation),
+                                  p.motion.rotation / rot_limit),
                  p.speed / v_rest, wall);
   };
+  return spec;
+}
+
+}  // namespace
+
+TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& crit,
+                      bool quiet) {
+  const auto t0 = Clock::now();
+  Simulation sim = settled.sim;  // deep copy
+  RunSpec spec = trial_spec(settled, lambda, crit, quiet);
   const Outcome o = run_engine(sim, spec);
 
   TrialResult r;
@@ -161,6 +173,45 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   }
   r.wall_s = seconds_since(t0);
   return r;
+}
+
+MovieReport record_trial(const SettledState& settled, double lambda, const TrialCriteria& crit,
+                         double frame_every, const std::string& h5_path, bool quiet) {
+  const auto t0 = Clock::now();
+  Simulation sim = settled.sim;  // deep copy, as run_trial
+  RunSpec spec = trial_spec(settled, lambda, crit, quiet);
+  spec.label = "the movie of " + spec.label;
+  // Past the collapse criterion: on to the end of the movie (on_sample below decides).
+  spec.min_time = std::numeric_limits<double>::infinity();
+  RunWriter writer;
+  writer.open(h5_path, sim.model, {"position"});
+  MovieReport m;
+  const double d_end = kMovieDisplacement * settled.l_ref;
+  double next_frame = 0.0;
+  spec.sample_at_start = true;
+  spec.on_sample = [&](const Simulation& s, const Probe& p) {
+    if (p.time >= next_frame - 0.5 * s.ctx.dt) {
+      const double ramp = crit.ramp_time > 0.0 ? std::min(1.0, p.time / crit.ramp_time) : 1.0;
+      writer.write_snapshot(p.time, s.model, {});
+      write_snapshot_thrust(writer, s.model, s.contact, s.ctx.dt, lambda * ramp);
+      next_frame += frame_every;
+      ++m.frames;
+      m.duration = p.time;
+    }
+    return m.frames < kMovieFrames && p.motion.rotation < kMovieRotation &&
+           p.motion.displacement < d_end;
+  };
+  try {
+    const Outcome o = run_engine(sim, spec);
+    m.collapsed = o.collapsed;
+    m.collapse_time = o.decided_at;
+    writer.close_complete();
+  } catch (const std::exception& e) {
+    writer.close_incomplete(e.what());
+    throw;
+  }
+  m.wall_s = seconds_since(t0);
+  return m;
 }
 
 std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
@@ -450,6 +501,16 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     }
   }
   keep_joints(lo, hi, true);
+  // The movie: the collapsed trial at hi run again with snapshots (record_trial), about
+  // kMovieFramesToCollapse frames until its collapse criterion fired.
+  if (!search.movie.empty())
+    for (const TrialResult& r : res.trials) {
+      if (!r.collapsed || r.lambda != hi || res.has_movie) continue;
+      if (!quiet) std::fprintf(stderr, "recording the trial lambda = %.5f for the movie\n", hi);
+      const double every = std::max(res.dt, r.sim_time / kMovieFramesToCollapse);
+      res.movie = record_trial(settled, hi, crit, every, search.movie, quiet);
+      res.has_movie = true;
+    }
   res.lo = lo;
   res.hi = hi;
   res.lambda_star = 0.5 * (lo + hi);

@@ -108,6 +108,29 @@ std::string settled_fingerprint(const SettledState& settled, const TrialCriteria
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria,
                       bool quiet);
 
+// The movie of a trial (`capacity --movie`, docs/thrust.md): the trial run again from the
+// settled state (bit for bit the trial that was classified: same state, load and rules) with
+// a snapshot every `frame_every` of trial time to the HDF5 file `h5_path` -- node positions,
+// the joint resultants and the load factor acting (attribute "lambda", ramped); snapshot
+// times count from the start of the lambda ramp. It goes on past the collapse criterion, so
+// that the mechanism is seen moving, until a free block has rotated kMovieRotation or moved
+// kMovieDisplacement x L_ref since the settled state, or kMovieFrames frames are written.
+inline constexpr double kMovieRotation = 0.35;     // [rad], about 20 degrees
+inline constexpr double kMovieDisplacement = 1.0;  // x L_ref
+inline constexpr int kMovieFrames = 150;
+inline constexpr double kMovieFramesToCollapse = 40.0;  // frames up to the collapse criterion
+
+struct MovieReport {
+  int frames = 0;
+  double duration = 0.0;       // [s] trial time of the last frame
+  bool collapsed = false;      // the collapse criterion fired
+  double collapse_time = 0.0;  // [s] trial time when it did
+  double wall_s = 0.0;
+};
+
+MovieReport record_trial(const SettledState& settled, double lambda, const TrialCriteria& crit,
+                         double frame_every, const std::string& h5_path, bool quiet);
+
 // How the search starts and what it remembers.
 struct CapacitySearch {
   int points = 2;                      // trial lambdas per round
@@ -120,6 +143,9 @@ struct CapacitySearch {
   // capacity run resumes where it stopped. Empty = none.
   std::string journal;
   bool quiet = false;
+  // When set and a collapse is bracketed: the collapsed trial at the upper bound recorded by
+  // record_trial to this HDF5 file (CapacityResult::movie).
+  std::string movie;
 };
 
 inline constexpr double kSeedLow = 0.92;   // FDEM lambda* lies a few % below the rigid LA one
@@ -156,6 +182,8 @@ struct CapacityResult {
   // exists.
   std::vector<JointResultant> joints_settled, joints_stable, joints_collapsed;
   bool has_stable = false, has_collapsed = false;
+  bool has_movie = false;              // CapacitySearch::movie was recorded
+  MovieReport movie;
 };
 
 // Bisection for lambda*; progress lines on stderr unless quiet.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,7 @@
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plot.hpp"
+#include "io/hdf5_output.hpp"
 #include "io/json.hpp"
 
 namespace voussoir {
@@ -131,7 +133,7 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
 }
 
 // The failure-mode JSON and picture of the governing search.
-void write_mode(const CapacityResult& res, const CapacityOptions& opts) {
+void write_mode(const CapacityResult& res, const CapacityOptions& opts, const std::string& deck) {
   if ((!opts.mode_out.empty() || !opts.picture.empty()) && !res.has_mode)
     std::fprintf(stderr, "voussoir: no failure-mode picture: %s\n",
                  res.bracketed ? "the collapsed trial came from the journal" : "no collapse found");
@@ -140,27 +142,50 @@ void write_mode(const CapacityResult& res, const CapacityOptions& opts) {
   // The lines of thrust under gravity and at the last stable lambda (drivers/thrust.hpp).
   char stable[64];
   std::snprintf(stable, sizeof stable, "last stable lambda = %.4f", res.lo);
+  mode["lambda"] = res.hi;  // of the collapsed trial drawn
   mode["thrust"] = nlohmann::json::array();
   mode["thrust"].push_back({{"label", "gravity"}, {"joints", joints_json(res.joints_settled)}});
   if (res.has_stable && res.lo > 0.0)
     mode["thrust"].push_back({{"label", stable}, {"joints", joints_json(res.joints_stable)}});
   if (!opts.mode_out.empty()) write_json(mode, opts.mode_out);
   if (!opts.picture.empty()) {
-    const std::string tmp = opts.picture + ".mode.json";
-    write_json(mode, tmp);
     char title[160];
-    std::snprintf(title, sizeof title, "failure mode at lambda = %.4f (lambda* = %.4f)", res.hi,
-                  res.lambda_star);
-    draw_with_script("draw", {tmp, "-o", opts.picture, "--no-mesh", "--title", title},
-                     opts.picture);
-    std::remove(tmp.c_str());
+    std::snprintf(title, sizeof title, "%s: lambda* = %.4f, bracket [%.4f, %.4f]",
+                  std::filesystem::path(deck).stem().c_str(), res.lambda_star, res.lo, res.hi);
+    draw_geometry(mode, opts.picture, {"--no-mesh", "--title", title});
   }
+}
+
+// Where the movie trial of direction d goes (removed once drawn).
+std::string movie_h5(const CapacityOptions& opts, const std::string& d) {
+  return opts.movie + (d == "-x" ? ".-x" : ".+x") + ".h5";
+}
+
+// --movie: the recorded trial of the governing search drawn by scripts/animate.
+void write_movie(const CapacityResult& res, const CapacityOptions& opts, const std::string& h5,
+                 const std::string& deck) {
+  if (!res.has_movie) {
+    std::fprintf(stderr, "voussoir: no movie: no collapse found\n");
+    return;
+  }
+  char label[160];
+  std::snprintf(label, sizeof label, "%s: capacity trial at the upper bound of lambda* = %.4f",
+                std::filesystem::path(deck).stem().c_str(), res.lambda_star);
+  if (draw_with_script("animate", {h5, "-o", opts.movie, "--label", label}, opts.movie))
+    std::printf("movie %s: %d frames, %.3f s of the trial (collapse criterion at %.3f s)\n",
+                opts.movie.c_str(), res.movie.frames, res.movie.duration,
+                res.movie.collapse_time);
 }
 
 }  // namespace
 
 int command_capacity(const Config& config, const CommonOptions& common,
                      const CapacityOptions& opts) {
+  if (!opts.movie.empty()) {
+    const std::string ext = std::filesystem::path(opts.movie).extension().string();
+    if (ext != ".gif" && ext != ".mp4")
+      throw DeckError("--movie " + opts.movie + ": the movie must end in .gif or .mp4");
+  }
   TrialCriteria criteria = opts.criteria;
   criteria.limits = common.limits;
   criteria.quasi_static = !opts.dynamic;
@@ -183,6 +208,7 @@ int command_capacity(const Config& config, const CommonOptions& common,
     c.direction = d == "-x" ? -1.0 : 1.0;
     CapacitySearch s = search;
     if (directions.size() > 1 && !s.journal.empty()) s.journal += d == "-x" ? ".-x" : ".+x";
+    if (!opts.movie.empty()) s.movie = movie_h5(opts, d);
     if (directions.size() > 1 && !common.quiet)
       std::fprintf(stderr, "direction %s\n", d.c_str());
     results.push_back(find_capacity(config, c, s));
@@ -198,7 +224,15 @@ int command_capacity(const Config& config, const CommonOptions& common,
   if (results.size() > 1)
     std::printf("governing direction %s: lambda* = %.4f\n", directions[governing].c_str(),
                 results[governing].lambda_star);
-  write_mode(results[governing], opts);
+  write_mode(results[governing], opts, config.deck_path);
+  if (!opts.movie.empty()) {
+    write_movie(results[governing], opts, movie_h5(opts, directions[governing]),
+                config.deck_path);
+    for (const std::string& d : directions) {
+      std::remove(movie_h5(opts, d).c_str());
+      std::remove(xdmf_path_for(movie_h5(opts, d)).c_str());
+    }
+  }
 
   if (!common.json_path.empty()) {
     nlohmann::json j = capacity_json(results[governing], opts);

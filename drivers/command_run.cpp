@@ -18,6 +18,8 @@
 
 #include "core/cst.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/motion.hpp"
+#include "drivers/plot.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/thrust.hpp"
@@ -110,6 +112,27 @@ std::string checkpoint_path(const RunOptions& opts, const std::string& out_path,
   return (stem.empty() ? std::string("run") : stem) + ".ckpt";
 }
 
+// --picture: the blocks at the end of the run (true displacements), the reference outlines
+// dashed, the line of thrust of the final state, and the hinges: joints opened by more than
+// kHingeFraction x L_ref that still carry a force (blocks that have fallen apart are not
+// hinged).
+void draw_final_state(const Simulation& sim, double lambda, const std::string& picture) {
+  const std::vector<JointResultant> joints =
+      joint_resultants(sim.model, sim.contact, sim.ctx.dt);
+  const double tol = kHingeFraction * reference_length(sim.model);
+  std::vector<Hinge> hinges;
+  for (const Hinge& h : find_hinges(sim.model, tol, tol))
+    if (joints[std::size_t(h.joint)].closed) hinges.push_back(h);
+  nlohmann::json geo = failure_mode_json(sim.model, hinges);
+  char label[64];
+  std::snprintf(label, sizeof label, "t = %.4g s", sim.ctx.time);
+  geo["thrust"] = {{{"label", label}, {"joints", joints_json(joints)}}};
+  char title[96];
+  std::snprintf(title, sizeof title, "end of the run: t = %.4g s, lambda = %.4g", sim.ctx.time,
+                lambda);
+  draw_geometry(geo, picture, {"--no-mesh", "--scale", "1", "--title", title});
+}
+
 }  // namespace
 
 int command_run(const Config& config, const CommonOptions& common, const RunOptions& opts) {
@@ -162,6 +185,8 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
     if (s.ctx.time >= book.next_snapshot - 0.5 * info.dt) {
       writer.write_snapshot(s.ctx.time, s.model,
                             want_stress ? triangle_stresses(s) : std::vector<double>{});
+      // The line of thrust of this state (docs/thrust.md), from a copy of the contact system.
+      write_snapshot_thrust(writer, s.model, s.contact, s.ctx.dt, config.load.lambda);
       book.next_snapshot += snap_every;
     }
     return true;
@@ -208,6 +233,7 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
       static_cast<long long>(sim.contact.active_pairs()),
       static_cast<long long>(stats.max_active_pairs));
   if (write) std::printf("output %s (+ %s)\n", out_path.c_str(), writer.xdmf_path().c_str());
+  if (!opts.picture.empty()) draw_final_state(sim, config.load.lambda, opts.picture);
 
   if (!common.json_path.empty()) {
     nlohmann::json j = {{"steps", stats.steps},

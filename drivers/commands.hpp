@@ -57,6 +57,7 @@ struct RunOptions {
   double checkpoint_every = 0.0;  // --checkpoint-every T: every T s of simulated time; 0 = never
   std::string checkpoint;    // --checkpoint FILE (default OUTPUT.ckpt, else DECKNAME.ckpt)
   std::string restart;       // --restart FILE: continue the run saved in FILE
+  std::string picture;       // --picture FILE.png|svg: the final state with its line of thrust
 };
 
 int command_run(const Config& config, const CommonOptions& common, const RunOptions& opts);
@@ -78,6 +79,7 @@ struct CapacityOptions {
   std::string resume;        // --resume FILE: journal of finished trials (created if absent)
   std::string mode_out;      // --mode-out FILE.json: deformed state of the collapse with hinges
   std::string picture;       // --picture FILE.png|svg: the same drawn by scripts/draw
+  std::string movie;         // --movie FILE.gif|mp4: the collapsed trial at the upper bound
   TrialCriteria criteria;    // --ramp-time, --rest-speed, ... (docs/capacity.md)
   bool dynamic = false;      // --dynamic: no quasi-static damping (the physical trials)
   std::string direction = "+x";  // --direction +x | -x | both

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "io/json.hpp"
+
 namespace voussoir {
 
 namespace {
@@ -42,6 +44,17 @@ bool draw_with_script(const std::string& script, const std::vector<std::string>&
                code >= 0 ? ("exited with status " + std::to_string(code)).c_str()
                          : "could not be run");
   return false;
+}
+
+bool draw_geometry(const nlohmann::json& geometry, const std::string& picture,
+                   const std::vector<std::string>& args) {
+  const std::string tmp = picture + ".geometry.json";
+  write_json(geometry, tmp);
+  std::vector<std::string> all = {tmp, "-o", picture};
+  all.insert(all.end(), args.begin(), args.end());
+  const bool ok = draw_with_script("draw", all, picture);
+  std::remove(tmp.c_str());
+  return ok;
 }
 
 }  // namespace voussoir

@@ -128,4 +128,22 @@ nlohmann::json joints_json(const std::vector<JointResultant>& joints) {
   return out;
 }
 
+SnapshotJoints snapshot_joints(const std::vector<JointResultant>& joints) {
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  SnapshotJoints out;
+  for (const JointResultant& r : joints) {
+    out.normal_force.push_back(r.normal_force);
+    out.shear_force.push_back(r.shear_force);
+    out.eccentricity.push_back(r.closed ? r.eccentricity : kNone);
+    out.point.insert(out.point.end(), {r.closed ? r.point.x : kNone, r.closed ? r.point.y : kNone});
+  }
+  return out;
+}
+
+void write_snapshot_thrust(RunWriter& writer, const Model& model, const ContactSystem& contact,
+                           double dt, double lambda) {
+  writer.write_snapshot_joints(snapshot_joints(joint_resultants(model, contact, dt)));
+  writer.write_snapshot_attribute("lambda", lambda);
+}
+
 }  // namespace voussoir

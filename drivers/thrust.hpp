@@ -37,6 +37,7 @@
 #include "contact/contact.hpp"
 #include "core/model.hpp"
 #include "drivers/kinematics.hpp"
+#include "io/hdf5_output.hpp"
 
 namespace voussoir {
 
@@ -63,5 +64,15 @@ std::vector<JointResultant> joint_resultants(const Model& model,
 //   "point": [x, y], "force": [Fx, Fy]}]; e and point are null for an open joint; force is F,
 // the force of block a on block b.
 nlohmann::json joints_json(const std::vector<JointResultant>& joints);
+
+// The same as the HDF5 writer takes them (io/hdf5_output.hpp): NaN eccentricity and point for
+// an open joint.
+SnapshotJoints snapshot_joints(const std::vector<JointResultant>& joints);
+
+// Writes the joint resultants of the current state of (model, contact) into the writer's last
+// snapshot, with the load factor `lambda` acting then as its attribute "lambda". Computed on a
+// copy of the contact system: the run's state and results are untouched.
+void write_snapshot_thrust(RunWriter& writer, const Model& model, const ContactSystem& contact,
+                           double dt, double lambda);
 
 }  // namespace voussoir

@@ -146,6 +146,7 @@ struct RunWriter::Impl {
   std::vector<std::string> fields;
   bool want_position = false, want_velocity = false, want_stress = false;
   Index nodes = 0, tris = 0;
+  std::size_t joints = 0;  // the model's joints (/mesh/joint_blocks)
 
   H5Handle file;
   std::array<H5Handle, kSeriesDoubles> series;
@@ -372,6 +373,15 @@ void RunWriter::open(const std::string& path, const Model& model,
     std::vector<std::int32_t> fixed;
     for (const Block& b : model.blocks) fixed.push_back(b.fixed ? 1 : 0);
     s.write_array(mesh.get(), "fixed", H5T_NATIVE_INT32, fixed.size(), 0, fixed.data());
+    std::vector<std::int32_t> joint_blocks;
+    std::vector<double> joint_ends;
+    for (const Joint& j : model.joints) {
+      joint_blocks.insert(joint_blocks.end(), {j.block_a, j.block_b});
+      joint_ends.insert(joint_ends.end(), {j.a.x, j.a.y, j.b.x, j.b.y});
+    }
+    s.joints = model.joints.size();
+    s.write_array(mesh.get(), "joint_blocks", H5T_NATIVE_INT32, s.joints, 2, joint_blocks.data());
+    s.write_array(mesh.get(), "joint_ends", H5T_NATIVE_DOUBLE, s.joints, 4, joint_ends.data());
   }
   // /series
   {
@@ -515,6 +525,56 @@ void RunWriter::write_snapshot(double time, const Model& model,
   }
   s.snapshot_times.push_back(time);
   s.check(H5Fflush(s.file.get(), H5F_SCOPE_LOCAL), "flush");
+}
+
+void RunWriter::write_snapshot_joints(const SnapshotJoints& j) {
+  Impl& s = *impl_;
+  if (!is_open()) throw std::logic_error("RunWriter::write_snapshot_joints: not open");
+  if (snapshot_count() == 0)
+    throw std::logic_error("RunWriter::write_snapshot_joints: no snapshot written yet");
+  const std::size_t J = s.joints;
+  if (j.normal_force.size() != J || j.shear_force.size() != J || j.eccentricity.size() != J ||
+      j.point.size() != 2 * J)
+    throw std::logic_error("RunWriter::write_snapshot_joints: expected " + std::to_string(J) +
+                           " joints (points 2 x J)");
+  const double time = s.snapshot_times.back();
+  // Forces finite; eccentricity and point finite, or all three NaN (an open joint).
+  for (std::size_t k = 0; k < J; ++k) {
+    const bool open = std::isnan(j.eccentricity[k]);
+    const bool ok = std::isfinite(j.normal_force[k]) && std::isfinite(j.shear_force[k]) &&
+                    (open ? std::isnan(j.point[2 * k]) && std::isnan(j.point[2 * k + 1])
+                          : std::isfinite(j.eccentricity[k]) && std::isfinite(j.point[2 * k]) &&
+                                std::isfinite(j.point[2 * k + 1]));
+    if (!ok)
+      throw std::runtime_error("refusing to write a non-finite resultant of joint " +
+                               std::to_string(k) + " at t = " + format_time(time) + " s to " +
+                               s.path);
+  }
+  const std::string name = "/snapshots/" + snapshot_name(snapshot_count() - 1) + "/joints";
+  H5Handle group(
+      s.check(H5Gcreate2(s.file.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+              "create " + name),
+      H5Gclose);
+  s.write_array(group.get(), "normal_force", H5T_NATIVE_DOUBLE, J, 0, j.normal_force.data());
+  s.write_array(group.get(), "shear_force", H5T_NATIVE_DOUBLE, J, 0, j.shear_force.data());
+  s.write_array(group.get(), "eccentricity", H5T_NATIVE_DOUBLE, J, 0, j.eccentricity.data());
+  s.write_array(group.get(), "point", H5T_NATIVE_DOUBLE, J, 2, j.point.data());
+  s.check(H5Fflush(s.file.get(), H5F_SCOPE_LOCAL), "flush");
+}
+
+void RunWriter::write_snapshot_attribute(const char* name, double value) {
+  Impl& s = *impl_;
+  if (!is_open()) throw std::logic_error("RunWriter::write_snapshot_attribute: not open");
+  if (snapshot_count() == 0)
+    throw std::logic_error("RunWriter::write_snapshot_attribute: no snapshot written yet");
+  if (!std::isfinite(value))
+    throw std::runtime_error("refusing to write a non-finite " + std::string(name) + " at t = " +
+                             format_time(s.snapshot_times.back()) + " s to " + s.path);
+  const std::string group_name = "/snapshots/" + snapshot_name(snapshot_count() - 1);
+  H5Handle group(s.check(H5Gopen2(s.file.get(), group_name.c_str(), H5P_DEFAULT),
+                         "open " + group_name),
+                 H5Gclose);
+  s.write_attr_double(group.get(), name, value);
 }
 
 void RunWriter::close_complete() {

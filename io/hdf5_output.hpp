@@ -10,19 +10,33 @@
 //   /mesh/block            T       owning block of each triangle
 //   /mesh/node_block       N       owning block of each node
 //   /mesh/fixed            B       1 if the block is fixed (support), else 0
+//   /mesh/joint_blocks     J x 2   the two blocks a, b of each joint of the model (the joint
+//                                  index of `check --mesh-out` and of the hinge reports)
+//   /mesh/joint_ends       J x 4   reference ends a (x, y) and b (x, y) of each joint [m]
+//                                  (a: the intrados end of arch joints)
 //   /series/NAME           R       one row per append_series(): time [s], kinetic, strain,
 //                                  contact, damping_dissipated, friction_dissipated,
 //                                  external_work [J], max_displacement [m],
 //                                  active_contacts (int64), energy_balance_error [-]
 //   /series/control_displacement   R x C  (only if records carry control displacements;
 //                                  C fixed by the first record; attribute columns)
-//   /snapshots/NNNNNN/     attribute time [s]; datasets of the requested `fields`:
+//   /snapshots/NNNNNN/     attribute time [s] (simulation time; in the file of `capacity
+//                          --movie`, time since the start of the lambda ramp); datasets of
+//                          the requested `fields`:
 //                            position: position (N x 2) [m] and displacement (N x 3: ux,
 //                              uy, 0; position minus /mesh/nodes) [m],
 //                            velocity: velocity (N x 3: vx, vy, 0) [m/s],
 //                            stress: stress_xx, stress_yy, stress_xy, stress_1, stress_2
 //                              (T each: Cauchy components, in-plane principal stresses
-//                              s1 >= s2) [Pa]
+//                              s1 >= s2) [Pa];
+//                          attribute lambda (only when the driver gives it: the horizontal
+//                          load factor acting at that time);
+//   /snapshots/NNNNNN/joints/  the joint resultants at that state (only when the driver gives
+//                          them: `voussoir run`, `capacity --movie`; docs/thrust.md):
+//                            normal_force (J) [N], compression positive; shear_force (J) [N];
+//                            eccentricity (J) [-1 at end a, +1 at end b]; point (J x 2) [m],
+//                            the centre of pressure; eccentricity and point are NaN for an
+//                            open joint (no centre of pressure)
 //
 // XDMF (ParaView): a Temporal collection with a Time value on every grid; the geometry is the
 // reference mesh (/mesh/nodes) and `displacement` a 3-component point vector, so ParaView's
@@ -44,7 +58,8 @@
 //     can be taken for a finished run. No XDMF is written for it.
 //
 // Non-finite values are refused (std::runtime_error naming the field, the item and the time):
-// a NaN is never written silently. Errors of the HDF5 library or the file system throw
+// a NaN is never written silently. The one NaN the file holds on purpose is the open joint's
+// eccentricity and point (both NaN together, never infinite). Errors of the HDF5 library or the file system throw
 // OutputError (io/json.hpp) naming the file.
 // Series rows are buffered in memory and written in blocks (every kSeriesBlock rows, at each
 // snapshot and at close), so appending a row costs no HDF5 call in the common case.
@@ -76,6 +91,14 @@ struct SeriesRecord {
   std::vector<double> control_displacements;
 };
 
+// Joint resultants of one snapshot, J values each (drivers/thrust.hpp makes them).
+struct SnapshotJoints {
+  std::vector<double> normal_force;  // [N], compression positive
+  std::vector<double> shear_force;   // [N]
+  std::vector<double> eccentricity;  // [-]; NaN for an open joint
+  std::vector<double> point;         // J x 2 interleaved [m]; NaN for an open joint
+};
+
 class RunWriter {
  public:
   RunWriter();
@@ -97,6 +120,13 @@ class RunWriter {
   // written as the named scalars of the layout above;
   // it is read only when "stress" is among the fields (may be empty otherwise).
   void write_snapshot(double time, const Model& model, const std::vector<double>& stress_xx_yy_xy);
+
+  // Optional, after write_snapshot and before the next one: the joint resultants of that
+  // snapshot's state, under /snapshots/NNNNNN/joints (J = the model's joint count).
+  void write_snapshot_joints(const SnapshotJoints& joints);
+
+  // Optional, after write_snapshot: a scalar attribute of that snapshot (e.g. "lambda").
+  void write_snapshot_attribute(const char* name, double value);
 
   // Finishes the run: the file appears at `path` with complete = 1, then the XDMF.
   void close_complete();
