@@ -28,11 +28,15 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
+bool quasi_static_trials(const Config& config, bool asked) {
+  return asked && config.material.model != "rigid";
+}
+
 SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet) {
   const auto t0 = Clock::now();
   SettledState s;
   s.sim = make_simulation(config);
-  if (crit.quasi_static) {
+  if (quasi_static_trials(config, crit.quasi_static)) {
     s.sim.ctx.local_damping = config.capacity.local_damping;
     s.sim.ctx.local_damping_outgoing = config.capacity.local_damping_mode == "outgoing";
   }

@@ -19,9 +19,13 @@
 //      when neither happens by `max_time`, the trial is collapsed if the block motion is still
 //      growing (speed above the rest threshold), stable otherwise (reported as "timeout").
 // The thresholds are studied in docs/capacity.md. With TrialCriteria::quasi_static (the
-// default of `capacity` and `sweep`) the settle and the trials run with the local damping of
-// the deck's capacity.local_damping (core/integrate.hpp LocalDamping; docs/capacity.md
-// "Quasi-static decisions"); TrialCriteria::direction points lambda g towards -x.
+// default of `capacity` and `sweep`) the settle and the trials of elastic blocks run with the
+// local damping of the deck's capacity.local_damping (core/integrate.hpp LocalDamping;
+// docs/capacity.md "Quasi-static decisions"). Rigid blocks keep the physical settle and trials:
+// on their three degrees of freedom the damping arrests a sliding mechanism, and lambda* of
+// the sliding semicircular arch at beta = 120 came out 11% above the limit analysis that
+// bounds it (quasi_static_trials below; docs/capacity.md). TrialCriteria::direction points
+// lambda g towards -x.
 //
 // Bisection: the bracket [lo, hi] (stable at lo, collapsed at hi) shrinks by k-section with
 // `points` trial lambdas per round (run in parallel on the available cores); the number of
@@ -55,6 +59,10 @@ struct TrialCriteria {
   double direction = 1.0;              // of lambda g: +1 towards +x, -1 towards -x
   RunLimits limits;                    // guards and the user's limits (drivers/trial.hpp)
 };
+
+// Whether the settle and the trials of `config` run quasi-static when `asked` (capacity and
+// sweep unless --dynamic): for elastic blocks only (above).
+bool quasi_static_trials(const Config& config, bool asked);
 
 struct TrialResult {
   double lambda = 0.0;
