@@ -4,15 +4,17 @@ twice, labelled `mpi`, where the program is built with MPI:
 
   --part same     a 12-cell sweep (cases/block.toml, friction x width), a 16-cell corner of the
                   Gilbert stability map and a 4-frequency pulse curve, each run in one process
-                  and under mpirun -n 2 (1 thread a rank): the same CSV byte for byte once the
-                  wall_s column is removed; the JSON says how many ranks ran.
+                  (2 threads) and under mpirun -n 2 (1 thread a rank): the same CSV byte for
+                  byte once the wall_s column is removed; the JSON says how many ranks ran. The
+                  map once more with a step budget that 6 cells exceed: the same failed rows,
+                  exit status 1.
   --part resume   the MPI sweep with a journal; the journal cut after 5 of its 12 cells and half
                   a line (what a kill leaves); the MPI sweep resumed: the same CSV as the
                   uninterrupted one (the 5 kept cells with their journalled wall_s), the count of
                   kept cells on stderr, and every cell journalled once (none run twice).
 
 Settings are the cheap ones of the unit tests (coarse tolerance, soft coarse arch, short
-times), so that the whole of each part takes well under a minute on 2 cores.
+times): about 30 s of CPU for --part same, 10 s for --part resume.
 Usage: tests/python/mpi_ranks.py --bin build/voussoir --mpirun mpirun --work DIR --part same"""
 import argparse
 import csv
@@ -56,10 +58,11 @@ def rows_without_wall(path):
 
 
 def study(a, name, args, ranks, extra=()):
-    """One run of a study, in one process (ranks 1) or under mpirun; returns its paths and
-    its (status, stdout, stderr)."""
+    """One run of a study, in one process of 2 threads (ranks 1) or under mpirun with 1 thread
+    a rank; returns its paths and its (status, stdout, stderr)."""
     out = os.path.join(a.work, f"{name}_{ranks}")
-    cmd = [a.bin] + args + ["--threads", "1", "--csv", out + ".csv", "--json", out + ".json"]
+    threads = "2" if ranks == 1 else "1"
+    cmd = [a.bin] + args + ["--threads", threads, "--csv", out + ".csv", "--json", out + ".json"]
     cmd += list(extra)
     if ranks > 1:
         cmd = [a.mpirun] + MPI_FLAGS + cmd
@@ -67,8 +70,12 @@ def study(a, name, args, ranks, extra=()):
 
 
 def same(a):
+    # A step budget that the 6 standing cells of the map exceed (they run to rest or to
+    # --max-time; the collapsed ones stop at --ke-time): failed cells, reported in their rows
+    # while the others run, exit status 1, in one process as under mpirun.
+    failing = STABILITY + ["--max-steps", "20000"]
     for name, args, expect_rc in (("sweep", SWEEP, 0), ("stability", STABILITY, 0),
-                                  ("curve", CURVE, 0)):
+                                  ("curve", CURVE, 0), ("failing", failing, 1)):
         one, (rc1, _, err1) = study(a, name, args, 1)
         two, (rc2, out2, err2) = study(a, name, args, 2)
         check(rc1 == expect_rc, f"{name} in one process: exit {rc1}\n{err1[-2000:]}")
@@ -85,6 +92,10 @@ def same(a):
         # Rank 0 alone prints: one summary line.
         check(out2.count(" written to ") + out2.count("; curve ") == 1,
               f"{name}: stdout under mpirun is not one rank's:\n{out2}")
+    with open(os.path.join(a.work, "failing_2.csv"), newline="") as f:
+        reasons = [(r["reason"], r["error"] != "") for r in csv.DictReader(f)]
+    check(reasons.count(("error", True)) == 6 and len(reasons) == 16,
+          f"failing map: not 6 failed cells of 16 with their errors: {reasons}")
     # The sweep's 12 cells and the map's 16.
     check(len(rows_without_wall(os.path.join(a.work, "sweep_1.csv"))) == 13, "sweep: not 12 cells")
     check(len(rows_without_wall(os.path.join(a.work, "stability_1.csv"))) == 17,
