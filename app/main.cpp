@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   try {
     ranks.emplace(argc, argv);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "voussoir: error: %s\n", e.what());
+    if (voussoir::is_dealer_rank()) std::fprintf(stderr, "voussoir: error: %s\n", e.what());
     return 1;
   }
   // Under mpirun only rank 0 prints (messages and errors alike).

@@ -210,13 +210,17 @@ Ranks::Ranks(int& argc, char**& argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
 #else
-  if (launched > 1)
+  if (launched > 1) {
+    // The launcher's rank, so that one copy says it (main() prints on rank 0 only).
+    for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMI_RANK"})
+      if (const char* v = std::getenv(name)) g_rank = std::atoi(v);
     throw RunError(
-        "this voussoir was built without MPI (VOUSSOIR_MPI off: libopenmpi-dev "
-        "was missing when it was configured), so each of the " +
+        "this voussoir was built without MPI (CMake option VOUSSOIR_MPI off), so "
+        "each of the " +
         std::to_string(launched) +
         " copies mpirun started would run the whole study: run it without mpirun, "
         "or install Open MPI (scripts/install-deps) and build again (docs/mpi.md)");
+  }
 #endif
 }
 
