@@ -289,8 +289,9 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
     CurvePoint p;
     std::string error;
     try {
-      p = find_collapse_amplitude(settled, config.load.base, freqs[i], search, crit, quiet,
-                                  spread ? &share : runs_journal);
+      // Under mpirun the progress is a line per frequency, printed by rank 0 as it arrives.
+      p = find_collapse_amplitude(settled, config.load.base, freqs[i], search, crit,
+                                  quiet || rank_count() > 1, spread ? &share : runs_journal);
     } catch (const std::exception& e) {
       error = e.what();
       p.frequency = freqs[i];
