@@ -7,10 +7,12 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "drivers/commands.hpp"
+#include "drivers/dealer.hpp"
 #include "drivers/limit_command.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/setup.hpp"
@@ -40,6 +42,16 @@ void add_common(CLI::App* cmd, DeckArgs& deck, voussoir::CommonOptions& common) 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // MPI, when launched by mpirun or srun (drivers/dealer.hpp): for the life of main().
+  std::optional<voussoir::Ranks> ranks;
+  try {
+    ranks.emplace(argc, argv);
+  } catch (const std::exception& e) {
+    if (voussoir::is_dealer_rank()) std::fprintf(stderr, "voussoir: error: %s\n", e.what());
+    return 1;
+  }
+  // Under mpirun only rank 0 prints (messages and errors alike).
+  const bool speaks = voussoir::is_dealer_rank();
   CLI::App app{"voussoir " VOUSSOIR_VERSION
                " - collapse capacity of dry-joint masonry arches by FDEM"};
   app.require_subcommand(1);
@@ -212,11 +224,16 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (!speaks) return e.get_exit_code() == 0 ? 0 : 2;
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
 
   try {
+    // Under mpirun these deal their cells to the ranks; any other command runs on rank 0 alone.
+    const bool dealt =
+        sweep->parsed() || stability->parsed() || (pulse->parsed() && pulse_opts.curve);
+    if (!dealt && !speaks) return 0;
     if (keys->parsed()) {
       std::fputs(voussoir::deck_reference_markdown().c_str(), stdout);
       return 0;
@@ -236,13 +253,10 @@ int main(int argc, char** argv) {
       return voussoir::command_pulse(config, common, pulse_opts);
     }
   } catch (const voussoir::DeckError& e) {
-    std::fprintf(stderr, "voussoir: error: %s\n", e.what());
+    if (speaks) std::fprintf(stderr, "voussoir: error: %s\n", e.what());
     return 2;
-  } catch (const voussoir::RunError& e) {
-    std::fprintf(stderr, "voussoir: run failed: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "voussoir: run failed: %s\n", e.what());
+  } catch (const std::exception& e) {  // RunError and the rest: a failure during a run
+    if (speaks) std::fprintf(stderr, "voussoir: run failed: %s\n", e.what());
     return 1;
   }
   return 2;

@@ -1,18 +1,18 @@
 // `voussoir pulse DECK`: one base-excitation run (JSON, optional HDF5 and CSV series), or with
 // --curve the amplitude-frequency failure curve (CSV, plot, JSON). Criteria in pulse.hpp.
 
-#include <omp.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "drivers/commands.hpp"
+#include "drivers/dealer.hpp"
 #include "drivers/plot.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/run.hpp"
@@ -199,29 +199,42 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   crit.settle.limits = common.limits;
   crit.free_time = opts.free_time;
 
+  // Under mpirun only rank 0 (which prints) searches the tilting capacity; the other ranks
+  // wait for its lambda* (or for its failure, and stop without a word: rank 0 reports it).
+  const bool quiet = common.quiet || !is_dealer_rank();
   double lambda_star = opts.lambda_star;
   double capacity_wall = 0.0;
   if (lambda_star < 0.0) {
-    if (!common.quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
-    CapacitySearch capacity_search;
-    capacity_search.points = opts.points;
-    capacity_search.quiet = common.quiet;
-    if (!opts.resume.empty()) capacity_search.journal = opts.resume + ".capacity";
-    const CapacityResult cap = find_capacity(config, crit.settle, capacity_search);
-    // Without a collapse there is no tilting capacity, hence no quasi-static limit to start
-    // the curve from or to compare it with.
-    if (!cap.bracketed) {
-      char buf[200];
-      std::snprintf(buf, sizeof buf,
-                    "the tilting capacity search found %s = %.4f: no quasi-static limit for the "
-                    "curve (give one with --lambda-star)",
-                    kNoCollapse, cap.lo);
-      throw RunError(buf);
-    }
-    lambda_star = cap.lambda_star;
-    capacity_wall = cap.wall_s;
-    if (!common.quiet)
-      std::fprintf(stderr, "lambda* = %.4f (%.1f s wall)\n", lambda_star, capacity_wall);
+    nlohmann::json found;
+    std::exception_ptr failure;
+    if (is_dealer_rank()) try {
+        if (!quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
+        CapacitySearch capacity_search;
+        capacity_search.points = opts.points;
+        capacity_search.quiet = quiet;
+        if (!opts.resume.empty()) capacity_search.journal = opts.resume + ".capacity";
+        const CapacityResult cap = find_capacity(config, crit.settle, capacity_search);
+        // Without a collapse there is no tilting capacity, hence no quasi-static limit to start
+        // the curve from or to compare it with.
+        if (!cap.bracketed) {
+          char buf[200];
+          std::snprintf(buf, sizeof buf,
+                        "the tilting capacity search found %s = %.4f: no quasi-static limit for "
+                        "the curve (give one with --lambda-star)",
+                        kNoCollapse, cap.lo);
+          throw RunError(buf);
+        }
+        found = {{"lambda_star", cap.lambda_star}, {"wall_s", cap.wall_s}};
+      } catch (...) {
+        failure = std::current_exception();
+        found = {{"failed", true}};
+      }
+    found = share_from_dealer(found);
+    if (failure) std::rethrow_exception(failure);
+    if (found.is_null() || found.contains("failed")) return 1;
+    lambda_star = found["lambda_star"];
+    capacity_wall = found["wall_s"];
+    if (!quiet) std::fprintf(stderr, "lambda* = %.4f (%.1f s wall)\n", lambda_star, capacity_wall);
   }
   // Peak of the unit-amplitude pulse (0.891 for the 3-cycle windowed sine, 1 for one sine):
   // the quasi-static limit of the curve is A = lambda* / peak_factor.
@@ -236,10 +249,12 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   search.steps_above = opts.steps_above;
   search.tolerance = opts.tolerance;
 
-  const SettledState settled = settle(config, crit.settle, common.quiet);
+  const SettledState settled = settle(config, crit.settle, quiet);
   if (!settled.settled) throw RunError(unsettled_message(settled, crit.settle));
-  // Resume: every run of the curve in a journal (drivers/pulse.hpp find_collapse_amplitude).
-  Journal journal(opts.resume, pulse_fingerprint(settled, config.load.base, crit));
+  // Resume: every run of the curve in a journal (drivers/pulse.hpp find_collapse_amplitude),
+  // kept by rank 0.
+  Journal journal(is_dealer_rank() ? opts.resume : std::string(),
+                  pulse_fingerprint(settled, config.load.base, crit));
   Journal* runs_journal = opts.resume.empty() ? nullptr : &journal;
 
   // The costliest frequencies first for the dynamic schedule: for the bisection the lowest (the
@@ -254,24 +269,56 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   });
   std::vector<CurvePoint> points(freqs.size());
   std::vector<std::string> errors(freqs.size());
-  const int n = static_cast<int>(freqs.size());
-#pragma omp parallel for schedule(dynamic, 1) \
-    num_threads(std::max(1, std::min(n, omp_get_max_threads())))
-  for (int k = 0; k < n; ++k) {
+  // The frequencies are the cells (drivers/dealer.hpp), dealt in the order above. In one
+  // process every run is journalled as it finishes; under mpirun a frequency takes its runs
+  // already journalled with it, and rank 0 journals its new runs when the frequency comes back.
+  const bool spread = rank_count() > 1 && runs_journal;
+  auto runs_at = [&](double frequency) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const nlohmann::json& j : journal.records())
+      if (j.value("frequency", -1.0) == frequency) runs.push_back(j);
+    return runs;
+  };
+  CellWork work;
+  work.cells = freqs.size();
+  if (spread) work.input = [&](size_t k) { return runs_at(freqs[order[k]]); };
+  work.run = [&](size_t k, const nlohmann::json& given) {
     const int i = order[k];
+    Journal share(given.is_array() ? given.get<std::vector<nlohmann::json>>()
+                                   : std::vector<nlohmann::json>());
+    CurvePoint p;
+    std::string error;
     try {
-      points[i] =
-          find_collapse_amplitude(settled, config.load.base, freqs[i], search, crit, common.quiet,
-                                  runs_journal);
+      // Under mpirun the progress is a line per frequency, printed by rank 0 as it arrives.
+      p = find_collapse_amplitude(settled, config.load.base, freqs[i], search, crit,
+                                  quiet || rank_count() > 1, spread ? &share : runs_journal);
     } catch (const std::exception& e) {
-      errors[i] = e.what();
-      points[i].frequency = freqs[i];
+      error = e.what();
+      p.frequency = freqs[i];
     }
-    if (!common.quiet)
+    nlohmann::json record = curve_point_record(p);
+    record["error"] = error;
+    return record;
+  };
+  work.take = [&](size_t k, const nlohmann::json& record) {
+    const int i = order[k];
+    points[i] = curve_point_from_record(record);
+    errors[i] = record.at("error");
+    if (spread) {
+      const nlohmann::json known = runs_at(freqs[i]);
+      for (const nlohmann::json& run : record.at("runs"))
+        if (std::none_of(known.begin(), known.end(), [&](const nlohmann::json& j) {
+              return j.at("amplitude") == run.at("amplitude");
+            }))
+          journal.append(run);
+    }
+    if (!quiet)
       std::fprintf(stderr, "f = %.3f Hz: A = %.4f g (%d trials, %.1f s wall)%s%s\n", freqs[i],
                    points[i].amplitude, points[i].trials, points[i].wall_s,
                    errors[i].empty() ? "" : " error: ", errors[i].c_str());
-  }
+  };
+  deal_cells(work, common.threads, quiet);
+  if (!is_dealer_rank()) return 0;  // rank 0 writes the outputs (drivers/dealer.hpp)
   const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
 
   auto list_of = [](const std::vector<double>& v, const char* sep) {
@@ -375,6 +422,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
         {"dt", settled.sim.ctx.dt},
         {"triangles", settled.sim.model.tris.size()},
         {"csv", csv_path},
+        {"ranks", rank_count()},
         {"wall_s", wall}};
     if (opts.tilt_reference_given) j["tilt_reference"] = opts.tilt_reference;
     write_json(j, common.json_path);

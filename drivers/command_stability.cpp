@@ -13,6 +13,7 @@
 
 #include "core/fnv.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/dealer.hpp"
 #include "drivers/plot.hpp"
 #include "drivers/stability.hpp"
 #include "io/deck.hpp"
@@ -34,7 +35,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   crit.ke_time = opts.ke_time;
   crit.trial.limits = common.limits;
   crit.trial.max_time = opts.max_time;
-  if (!common.quiet)
+  if (!common.quiet && is_dealer_rank())
     std::fprintf(stderr,
                  "stability map: %zu cells, gravity only, KE read at %.3g s, "
                  "undecided cells decided at %.3g s\n",
@@ -47,9 +48,11 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   for (double v : {crit.ke_time, crit.trial.max_time, common.limits.drift_limit,
                    double(common.limits.max_steps), keep_modes ? 1.0 : 0.0})
     print.value(v);
-  Journal journal(opts.resume, print.hex());
-  const std::vector<StabilityCell> cells = run_stability_map(
-      grid, crit, common.threads, keep_modes, common.quiet, opts.resume.empty() ? nullptr : &journal);
+  Journal journal(is_dealer_rank() ? opts.resume : std::string(), print.hex());
+  const std::vector<StabilityCell> cells =
+      run_stability_map(grid, crit, common.threads, keep_modes, common.quiet,
+                        opts.resume.empty() ? nullptr : &journal);
+  if (!is_dealer_rank()) return 0;  // rank 0 writes the outputs (drivers/dealer.hpp)
 
   // CSV, written to a temporary name and renamed when complete.
   const std::string csv_path = opts.csv.empty() ? "stability.csv" : opts.csv;
@@ -165,6 +168,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
                 {"csv", csv_path},
                 {"stable", n_stable},
                 {"disagree", n_disagree},
+                {"ranks", rank_count()},
                 {"wall_s", wall}},
                common.json_path);
   }

@@ -1,8 +1,6 @@
 // `voussoir sweep DECK --param KEY=V1,V2,...`: capacity over a grid of deck values, cells in
 // parallel, one CSV row per cell (written as each finishes, in grid order at the end).
 
-#include <omp.h>
-
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +11,7 @@
 #include "core/fnv.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/dealer.hpp"
 #include "drivers/plot.hpp"
 #include "drivers/grid.hpp"
 #include "drivers/journal.hpp"
@@ -58,14 +57,14 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   print.value(opts.points);
   print.value(criteria.settle_max_time);
   if (criteria.quasi_static) print.text("quasi-static");
-  Journal journal(opts.resume, print.hex());
-  std::vector<bool> finished(cells, false);
-  for (const nlohmann::json& j : journal.records()) {
-    if (!j.contains("cell")) continue;
-    const size_t c = j["cell"];
+  Journal journal(is_dealer_rank() ? opts.resume : std::string(), print.hex());
+  // A cell's record (the journal's and the one sent between ranks) and back: one code path for
+  // the resumed, the local and the remote cells (drivers/dealer.hpp).
+  auto take_record = [&](size_t c, const nlohmann::json& j) {
     if (c >= cells || j["values"] != nlohmann::json(cell_values[c]))
       throw DeckError("--resume " + opts.resume + ": the journal belongs to another sweep");
     CapacityResult& r = results[c];
+    r = CapacityResult();
     r.lambda_star = j["lambda_star"];
     r.lo = j["lo"];
     r.hi = j["hi"];
@@ -74,54 +73,66 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
     r.wall_s = j["wall_s"];
     // The failure mode's joints (only their kind and index are tabulated).
     for (const char* kind : {"hinge", "sliding"})
-      for (const nlohmann::json& jt : j.value(std::string(kind) + "_joints", nlohmann::json::array())) {
+      for (const nlohmann::json& jt :
+           j.value(std::string(kind) + "_joints", nlohmann::json::array())) {
         Hinge h;
         h.kind = kind;
         h.joint = jt.get<int>();
         r.hinges.push_back(h);
       }
     errors[c] = j["error"];
-    finished[c] = true;
+  };
+  CellWork work;
+  work.cells = cells;
+  work.finished.assign(cells, 0);
+  for (const nlohmann::json& j : journal.records()) {
+    if (!j.contains("cell")) continue;
+    const size_t c = j["cell"];
+    take_record(c, j);
+    work.finished[c] = 1;
   }
-  int done = 0;
-#pragma omp parallel for schedule(dynamic, 1)
-  for (long c = 0; c < static_cast<long>(cells); ++c) {
-    if (finished[c]) continue;
+  work.run = [&](size_t c, const nlohmann::json&) {
+    CapacityResult r;
+    std::string error;
     try {
-      results[c] = find_capacity(configs[c], criteria, opts.points, true);
+      r = find_capacity(configs[c], criteria, opts.points, true);
     } catch (const std::exception& e) {
-      errors[c] = e.what();
+      error = e.what();
     }
-#pragma omp critical
-    {
-      const CapacityResult& r = results[c];
-      journal.append({{"cell", c},
-                      {"values", cell_values[c]},
-                      {"lambda_star", r.lambda_star},
-                      {"lo", r.lo},
-                      {"hi", r.hi},
-                      {"bracketed", r.bracketed},
-                      {"trials", r.trials.size()},
-                      {"wall_s", r.wall_s},
-                      {"hinge_joints", joint_indices(r.hinges, "hinge")},
-                      {"sliding_joints", joint_indices(r.hinges, "sliding")},
-                      {"error", errors[c]}});
-      ++done;
-      if (!common.quiet) {
-        std::fprintf(stderr, "[%d/%zu]", done, cells);
-        for (size_t k = 0; k < axes.size(); ++k)
-          std::fprintf(stderr, " %s=%s", axes[k].key.c_str(), cell_values[c][k].c_str());
-        if (!errors[c].empty())
-          std::fprintf(stderr, "  failed: %s\n", errors[c].c_str());
-        else if (!r.bracketed)
-          std::fprintf(stderr, "  %s = %.4f (%zu trials, %.1f s)\n", kNoCollapse, r.lo,
-                       r.trials.size(), r.wall_s);
-        else
-          std::fprintf(stderr, "  lambda* = %.4f, %s (%zu trials, %.1f s)\n", r.lambda_star,
-                       failure_mode_text(r).c_str(), r.trials.size(), r.wall_s);
-      }
+    return nlohmann::json{{"cell", c},
+                          {"values", cell_values[c]},
+                          {"lambda_star", r.lambda_star},
+                          {"lo", r.lo},
+                          {"hi", r.hi},
+                          {"bracketed", r.bracketed},
+                          {"trials", r.trials.size()},
+                          {"wall_s", r.wall_s},
+                          {"hinge_joints", joint_indices(r.hinges, "hinge")},
+                          {"sliding_joints", joint_indices(r.hinges, "sliding")},
+                          {"error", error}};
+  };
+  int done = 0;
+  work.take = [&](size_t c, const nlohmann::json& record) {
+    journal.append(record);
+    take_record(c, record);
+    const CapacityResult& r = results[c];
+    ++done;
+    if (!common.quiet) {
+      std::fprintf(stderr, "[%d/%zu]", done, cells);
+      for (size_t k = 0; k < axes.size(); ++k)
+        std::fprintf(stderr, " %s=%s", axes[k].key.c_str(), cell_values[c][k].c_str());
+      if (!errors[c].empty())
+        std::fprintf(stderr, "  failed: %s\n", errors[c].c_str());
+      else if (!r.bracketed)
+        std::fprintf(stderr, "  %s = %.4f (%zu trials, %.1f s)\n", kNoCollapse, r.lo,
+                     r.trials.size(), r.wall_s);
+      else
+        std::fprintf(stderr, "  lambda* = %.4f, %s (%zu trials, %.1f s)\n", r.lambda_star,
+                     failure_mode_text(r).c_str(), r.trials.size(), r.wall_s);
     }
-  }
+  };
+  deal_cells(work, common.threads, common.quiet);
+  if (!is_dealer_rank()) return 0;  // rank 0 writes the outputs (drivers/dealer.hpp)
 
   const std::string csv_path = opts.csv.empty() ? "sweep.csv" : opts.csv;
   std::ofstream csv(csv_path + ".tmp");
@@ -171,7 +182,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("sweep of %zu cells written to %s (%.1f s wall)\n", cells, csv_path.c_str(), wall);
   if (!common.json_path.empty())
-    write_json({{"cells", jcells}, {"csv", csv_path}, {"wall_s", wall}}, common.json_path);
+    write_json({{"cells", jcells}, {"csv", csv_path}, {"ranks", rank_count()}, {"wall_s", wall}}, common.json_path);
   if (!opts.plot.empty()) {
     draw_with_script("plot_sweep", {csv_path, "-o", opts.plot}, opts.plot);
   }

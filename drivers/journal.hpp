@@ -25,6 +25,9 @@ class Journal {
   // An empty path: no journal (nothing read or written). Throws RunError when the file holds
   // another fingerprint or cannot be written.
   Journal(const std::string& path, const std::string& fingerprint);
+  // Records held in memory only (a cell's share of rank 0's journal, sent with the cell under
+  // mpirun: drivers/dealer.hpp): read, appends dropped.
+  explicit Journal(std::vector<nlohmann::json> records) : records_(std::move(records)) {}
   const std::vector<nlohmann::json>& records() const { return records_; }
   // Appends one record (not thread-safe: callers serialise).
   void append(const nlohmann::json& record);

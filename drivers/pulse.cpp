@@ -309,6 +309,17 @@ PulseResult pulse_run_from_record(const nlohmann::json& j) {
   return r;
 }
 
+// nlohmann's conversions of a run (its journal record) and of a point, field by field.
+void to_json(nlohmann::json& j, const PulseResult& r) { j = pulse_run_record(r); }
+void from_json(const nlohmann::json& j, PulseResult& r) { r = pulse_run_from_record(j); }
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(CurvePoint, frequency, amplitude, lo, hi, bracketed, trials,
+                                   wall_s, max_energy_balance_error, stable_above, runs)
+
+nlohmann::json curve_point_record(const CurvePoint& point) { return point; }
+CurvePoint curve_point_from_record(const nlohmann::json& record) {
+  return record.get<CurvePoint>();
+}
+
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
                                    double frequency, const AmplitudeSearchOptions& search,
                                    const PulseCriteria& crit, bool quiet, Journal* journal) {

@@ -186,6 +186,12 @@ std::string pulse_fingerprint(const SettledState& settled, const BaseConfig& bas
 nlohmann::json pulse_run_record(const PulseResult& run);
 PulseResult pulse_run_from_record(const nlohmann::json& record);
 
+// A frequency's point as a record and back (every field and its runs; `pulse --curve` under
+// mpirun sends it from rank to rank, drivers/dealer.hpp). Its runs are not journal records of
+// their own: rank 0 journals them (pulse_run_record) as the point arrives.
+nlohmann::json curve_point_record(const CurvePoint& point);
+CurvePoint curve_point_from_record(const nlohmann::json& record);
+
 // The amplitudes of `runs` that survived above the smallest collapsing one, ascending.
 std::vector<double> stable_above_collapse(const std::vector<PulseResult>& runs);
 

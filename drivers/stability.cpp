@@ -4,8 +4,6 @@
 
 #include "drivers/stability.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -15,6 +13,7 @@
 #include <sstream>
 
 #include "core/scene_kinds.hpp"
+#include "drivers/dealer.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
@@ -214,32 +213,35 @@ StabilityCell stability_cell_from_record(const nlohmann::json& j) {
 std::vector<StabilityCell> run_stability_map(const Grid& grid,
                                              const StabilityCriteria& crit, int threads,
                                              bool keep_modes, bool quiet, Journal* journal) {
-  const long cells = static_cast<long>(grid.configs.size());
+  const size_t cells = grid.configs.size();
+  const bool dealer = is_dealer_rank();
   // Limit-analysis cross-checks first, serially (a few ms each; GLPK is not assumed to be
-  // thread-safe), so progress lines can flag disagreements.
+  // thread-safe), so progress lines can flag disagreements; on rank 0, which gathers.
   std::vector<StabilityCell> la(cells);
-  for (long c = 0; c < cells; ++c) check_limit_admissibility(grid.configs[c], la[c]);
+  if (dealer)
+    for (size_t c = 0; c < cells; ++c) check_limit_admissibility(grid.configs[c], la[c]);
 
+  // A cell's record (journal and ranks, drivers/dealer.hpp) into the map.
   std::vector<StabilityCell> out(cells);
-  std::vector<char> finished(cells, 0);
+  auto take_record = [&](size_t c, const nlohmann::json& j) {
+    if (c >= cells || j.at("values") != nlohmann::json(grid.values[c]))
+      throw RunError("the stability journal belongs to another grid (cell " +
+                     std::to_string(c) + ")");
+    out[c] = stability_cell_from_record(j);
+    out[c].la_admissible = la[c].la_admissible;
+    out[c].la_status = la[c].la_status;
+  };
+  CellWork work;
+  work.cells = cells;
+  work.finished.assign(cells, 0);
   if (journal)
     for (const nlohmann::json& j : journal->records()) {
       const long c = j.value("cell", -1L);
-      if (c < 0 || c >= cells || j.at("values") != nlohmann::json(grid.values[c]))
-        throw RunError("the stability journal belongs to another grid (cell " +
-                       std::to_string(c) + ")");
-      out[c] = stability_cell_from_record(j);
-      out[c].la_admissible = la[c].la_admissible;
-      out[c].la_status = la[c].la_status;
-      finished[c] = 1;
+      take_record(c < 0 ? cells : size_t(c), j);
+      work.finished[c] = 1;
     }
-  const int nthreads = threads > 0 ? threads : omp_get_max_threads();
-  const auto t0 = Clock::now();
-  int done = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
-  for (long c = 0; c < cells; ++c) {
-    if (finished[c]) continue;
-    StabilityCell& r = out[c];
+  work.run = [&](size_t c, const nlohmann::json&) {
+    StabilityCell r;
     try {
       std::string label;
       for (size_t k = 0; k < grid.axes.size(); ++k)
@@ -258,33 +260,34 @@ std::vector<StabilityCell> run_stability_map(const Grid& grid,
       r.friction = grid.configs[c].contact.friction;
     }
     r.values = grid.values[c];
-    r.la_admissible = la[c].la_admissible;
-    r.la_status = la[c].la_status;
-#pragma omp critical(stability_progress)
-    {
-      if (journal) {
-        nlohmann::json record = stability_cell_record(r);
-        record["cell"] = c;
-        journal->append(record);
-      }
-      ++done;
-      if (!quiet) {
-        std::fprintf(stderr, "[%d/%ld]", done, cells);
-        for (size_t k = 0; k < grid.axes.size(); ++k)
-          std::fprintf(stderr, " %s=%s", grid.axes[k].key.c_str(), grid.values[c][k].c_str());
-        if (r.error.empty())
-          std::fprintf(stderr,
-                       "  %-9s (%s at %.3f s) KE/MgL = %.3g at %.3f s; LA %s%s; %.1f s wall, "
-                       "%.0f s elapsed\n",
-                       r.stable ? "stable" : "collapsed", r.reason.c_str(), r.decision_time,
-                       r.normalised_ke, r.ke_read_time,
-                       r.la_admissible ? "admissible" : "not admissible",
-                       r.disagrees() ? " (DISAGREES)" : "", r.wall_s, seconds_since(t0));
-        else
-          std::fprintf(stderr, "  failed: %s\n", r.error.c_str());
-      }
+    nlohmann::json record = stability_cell_record(r);
+    record["cell"] = c;
+    return record;
+  };
+  const auto t0 = Clock::now();
+  int done = 0;
+  work.take = [&](size_t c, const nlohmann::json& record) {
+    take_record(c, record);
+    const StabilityCell& r = out[c];
+    if (journal) journal->append(record);
+    ++done;
+    if (!quiet) {
+      std::fprintf(stderr, "[%d/%zu]", done, cells);
+      for (size_t k = 0; k < grid.axes.size(); ++k)
+        std::fprintf(stderr, " %s=%s", grid.axes[k].key.c_str(), grid.values[c][k].c_str());
+      if (r.error.empty())
+        std::fprintf(stderr,
+                     "  %-9s (%s at %.3f s) KE/MgL = %.3g at %.3f s; LA %s%s; %.1f s wall, "
+                     "%.0f s elapsed\n",
+                     r.stable ? "stable" : "collapsed", r.reason.c_str(), r.decision_time,
+                     r.normalised_ke, r.ke_read_time,
+                     r.la_admissible ? "admissible" : "not admissible",
+                     r.disagrees() ? " (DISAGREES)" : "", r.wall_s, seconds_since(t0));
+      else
+        std::fprintf(stderr, "  failed: %s\n", r.error.c_str());
     }
-  }
+  };
+  deal_cells(work, threads, quiet);
   return out;
 }
 
