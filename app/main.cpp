@@ -144,6 +144,8 @@ int main(int argc, char** argv) {
   add_common(pulse, deck, common);
   voussoir::add_limit_options(pulse, common.limits);
   pulse->add_option("-o,--output", pulse_opts.output, "HDF5 output file (overrides output.file)");
+  pulse->add_option("--picture", pulse_opts.picture,
+                    "picture (PNG/SVG) of the single run's final state with its line of thrust");
   pulse->add_option("--series", pulse_opts.series,
                     "CSV time series of the run (input, energy, control points)");
   pulse->add_flag("--curve", pulse_opts.curve,

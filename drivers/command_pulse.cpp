@@ -125,8 +125,17 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
   };
   PulseResult r;
   try {
+    // --picture: the final state with its line of thrust (as `run --picture`).
+    auto picture = [&](const Simulation& sim) {
+      char title[128];
+      std::snprintf(title, sizeof title, "end of the pulse run: t = %.4g s, %s %.4g g at %.4g Hz",
+                    sim.ctx.time, config.load.base.signal.c_str(), config.load.base.amplitude,
+                    config.load.base.frequency);
+      draw_current_state(sim, title, opts.picture);
+    };
     r = run_pulse(settled, signal, config.load.lambda, points, crit,
-                  (write_h5 || csv) ? PulseRecorder(recorder) : PulseRecorder(), record_every);
+                  (write_h5 || csv) ? PulseRecorder(recorder) : PulseRecorder(), record_every,
+                  opts.picture.empty() ? std::function<void(const Simulation&)>() : picture);
     if (write_h5) writer.close_complete();
   } catch (const std::exception& e) {
     if (write_h5) writer.close_incomplete(e.what());
@@ -436,6 +445,9 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
 
 int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
   validate_pulse_options(opts);
+  if (opts.curve && !opts.picture.empty())
+    throw DeckError("--picture draws a single pulse run's final state: not with --curve (the "
+                    "curve's picture is --plot)");
   return opts.curve ? curve_run(config, common, opts) : single_run(config, common, opts);
 }
 

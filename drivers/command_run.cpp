@@ -112,11 +112,11 @@ std::string checkpoint_path(const RunOptions& opts, const std::string& out_path,
   return (stem.empty() ? std::string("run") : stem) + ".ckpt";
 }
 
-// --picture: the blocks at the end of the run (true displacements), the reference outlines
-// dashed, the line of thrust of the final state, and the hinges: joints opened by more than
-// kHingeFraction x L_ref that still carry a force (blocks that have fallen apart are not
-// hinged).
-void draw_final_state(const Simulation& sim, double lambda, const std::string& picture) {
+
+}  // namespace
+
+void draw_current_state(const Simulation& sim, const std::string& title,
+                        const std::string& picture) {
   const std::vector<JointResultant> joints =
       joint_resultants(sim.model, sim.contact, sim.ctx.dt);
   const double tol = kHingeFraction * reference_length(sim.model);
@@ -127,13 +127,8 @@ void draw_final_state(const Simulation& sim, double lambda, const std::string& p
   char label[64];
   std::snprintf(label, sizeof label, "t = %.4g s", sim.ctx.time);
   geo["thrust"] = {{{"label", label}, {"joints", joints_json(joints)}}};
-  char title[96];
-  std::snprintf(title, sizeof title, "end of the run: t = %.4g s, lambda = %.4g", sim.ctx.time,
-                lambda);
   draw_geometry(geo, picture, {"--no-mesh", "--scale", "1", "--title", title});
 }
-
-}  // namespace
 
 int command_run(const Config& config, const CommonOptions& common, const RunOptions& opts) {
   SetupInfo info;
@@ -233,7 +228,12 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
       static_cast<long long>(sim.contact.active_pairs()),
       static_cast<long long>(stats.max_active_pairs));
   if (write) std::printf("output %s (+ %s)\n", out_path.c_str(), writer.xdmf_path().c_str());
-  if (!opts.picture.empty()) draw_final_state(sim, config.load.lambda, opts.picture);
+  if (!opts.picture.empty()) {
+    char title[96];
+    std::snprintf(title, sizeof title, "end of the run: t = %.4g s, lambda = %.4g", sim.ctx.time,
+                  config.load.lambda);
+    draw_current_state(sim, title, opts.picture);
+  }
 
   if (!common.json_path.empty()) {
     nlohmann::json j = {{"steps", stats.steps},

@@ -37,6 +37,13 @@ nlohmann::json failure_mode_json(const Model& model, const std::vector<Hinge>& h
 
 nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges);
 
+// --picture of `run` and `pulse`: the blocks of `sim` as they are (true displacements), the
+// reference outlines dashed, the line of thrust of this state, and the hinges (joints opened by
+// more than kHingeFraction x L_ref that still carry a force: blocks that have fallen apart are
+// not hinged), under `title`. A drawing that fails is a warning (drivers/plot.hpp).
+void draw_current_state(const Simulation& sim, const std::string& title,
+                        const std::string& picture);
+
 // A capacity search in which no trial collapsed has no lambda*: the commands say so in these
 // words (text, JSON "result", sweep CSV "failure_mode"), with the highest lambda that stood.
 inline constexpr const char* kNoCollapse = "no collapse up to lambda_max";

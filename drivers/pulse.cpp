@@ -104,7 +104,8 @@ std::vector<ControlPoint> find_control_points(const Model& model) {
 
 PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, double lambda,
                       const std::vector<ControlPoint>& points, const PulseCriteria& crit,
-                      const PulseRecorder& recorder, double record_every) {
+                      const PulseRecorder& recorder, double record_every,
+                      const std::function<void(const Simulation&)>& at_end) {
   const auto wall0 = Clock::now();
   Simulation sim = settled.sim;  // deep copy
   const double g = settled.gravity;
@@ -221,6 +222,7 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   r.residual_displacement = o.motion.displacement;
   r.residual_rotation = o.motion.rotation;
   record(sim);
+  if (at_end) at_end(sim);
   r.steps = sim.step - step0;
   // Largest imbalance over the run relative to the run's peak energy (SPEC: "below 1% of the
   // peak energy"). Not the largest of balance_error() over time: early in a run that divides

@@ -136,10 +136,12 @@ struct PulseResult {
 };
 
 // One pulse run from a copy of `settled`. `recorder` (optional) is called every
-// `record_every` seconds of signal time (and at the start and the end).
+// `record_every` seconds of signal time (and at the start and the end); `at_end` (optional)
+// once with the final state (pulse --picture).
 PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, double lambda,
                       const std::vector<ControlPoint>& points, const PulseCriteria& criteria,
-                      const PulseRecorder& recorder = nullptr, double record_every = 1e-3);
+                      const PulseRecorder& recorder = nullptr, double record_every = 1e-3,
+                      const std::function<void(const Simulation&)>& at_end = nullptr);
 
 struct CurvePoint {
   double frequency = 0.0;     // [Hz]
@@ -198,6 +200,7 @@ std::vector<double> stable_above_collapse(const std::vector<PulseResult>& runs);
 struct PulseOptions {
   std::string output;           // -o FILE: HDF5 of the single run
   std::string series;           // --series FILE.csv: time series of the single run
+  std::string picture;          // --picture FILE.png|svg: the single run's final state
   bool curve = false;           // --curve
   std::vector<double> freqs;    // --freqs F1,F2,... [Hz]
   std::string csv;              // --csv FILE (curve; default curve.csv)

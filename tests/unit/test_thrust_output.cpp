@@ -147,6 +147,29 @@ TEST(ThrustOutput, RunHdf5JointsAreTheJsonJointsAtTheFinalSnapshot) {
   EXPECT_GT(closed, 6);
 }
 
+// pulse --picture: the shaking-table arch after a small 12 Hz pulse (survived) is drawn to a
+// PNG; with --curve the option is refused (exit 2) before any run.
+TEST(ThrustOutput, PulsePictureDrawsTheFinalStateAndIsRefusedWithTheCurve) {
+  const fs::path dir = scratch_dir();
+  const std::string png = (dir / "pulse.png").string();
+  const auto r = testing::run_process(
+      {VOUSSOIR_BINARY, "pulse", source("cases/scaled_arch.toml"), "-q", "--set",
+       "load.base.amplitude=0.05", "--set", "load.base.frequency=12", "--free-time", "0.2",
+       "--picture", png},
+      {}, (dir / "child").string());
+  ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
+  EXPECT_NE(r.out.find("survived"), std::string::npos) << r.out;
+  EXPECT_EQ(magic_of(png, 8), "\x89PNG\r\n\x1a\n");
+  const auto refused = testing::run_process(
+      {VOUSSOIR_BINARY, "pulse", source("cases/scaled_arch.toml"), "-q", "--curve", "--freqs",
+       "4", "--picture", (dir / "curve.png").string()},
+      {}, (dir / "child2").string());
+  ASSERT_TRUE(refused.exited) << refused.describe();
+  EXPECT_EQ(refused.status, 2) << refused.err;
+  EXPECT_NE(refused.err.find("--picture"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(dir / "curve.png"));
+}
+
 TEST(ThrustOutput, WriterRefusesNonFiniteResultantsAndWrongSizes) {
   const fs::path dir = scratch_dir();
   Simulation sim = make_simulation(parse_deck(
