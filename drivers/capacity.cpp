@@ -36,7 +36,7 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   const auto t0 = Clock::now();
   SettledState s;
   s.sim = make_simulation(config);
-  if (quasi_static_trials(config, crit.quasi_static)) {
+  if (crit.quasi_static) {
     s.sim.ctx.local_damping = config.capacity.local_damping;
     s.sim.ctx.local_damping_outgoing = config.capacity.local_damping_mode == "outgoing";
   }

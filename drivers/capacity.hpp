@@ -60,8 +60,10 @@ struct TrialCriteria {
   RunLimits limits;                    // guards and the user's limits (drivers/trial.hpp)
 };
 
-// Whether the settle and the trials of `config` run quasi-static when `asked` (capacity and
-// sweep unless --dynamic): for elastic blocks only (above).
+// Whether `capacity` and `sweep` run the settle and the trials of `config` quasi-static when
+// `asked` (unless --dynamic): for elastic blocks only (above). settle() and run_trial() do what
+// TrialCriteria::quasi_static says: a rigid model's equilibrium may still be relaxed with it
+// (the statics checks of drivers/thrust.hpp do), only its collapse decisions may not.
 bool quasi_static_trials(const Config& config, bool asked);
 
 struct TrialResult {

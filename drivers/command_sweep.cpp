@@ -95,7 +95,9 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
     CapacityResult r;
     std::string error;
     try {
-      r = find_capacity(configs[c], criteria, opts.points, true);
+      TrialCriteria cell = criteria;  // quasi-static for elastic blocks only
+      cell.quasi_static = quasi_static_trials(configs[c], criteria.quasi_static);
+      r = find_capacity(configs[c], cell, opts.points, true);
     } catch (const std::exception& e) {
       error = e.what();
     }
