@@ -114,8 +114,9 @@ inline void add_corners(const Index* c, const Index* d, const XY* on_c, const XY
 
 // A part of the contact forces whose work the ledger books by the trapezoid of its nodal
 // values at the two ends of each position increment (x^n - x^(n-1) = dt v^(n-1/2)): the impact
-// dashpots and the friction forces. `now` is filled during the step's contact stage, `prev`
-// holds the last step's; the threaded path writes each pair's corners to its slots first.
+// dashpots and the friction forces. `x`, `y` are filled during the step's contact stage,
+// `prev_x`, `prev_y` hold the last step's; the threaded path writes each pair's corners to its
+// slots first.
 struct TrackedForce {
   std::vector<double> x, y, prev_x, prev_y;  // per node [N]
   std::vector<double> slot_x, slot_y;        // [kPairSlots p + 2 k + side] [N]
