@@ -1,4 +1,4 @@
-// Study program (branch slide; not a benchmark): one capacity-style trial of a deck at a given
+// Study program (not a benchmark): one capacity-style trial of a deck at a given
 // lambda -- settle under gravity, ramp lambda g over 0.1 s, the trial's stop rules reported
 // but not stopping the run -- with a time series on stdout: kinetic energy, largest node speed,
 // largest block motion, the ledger's external work and friction / local / impact dissipation,

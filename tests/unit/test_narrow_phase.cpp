@@ -378,6 +378,63 @@ TEST(NarrowPhase, ThinStripEnergyMatchesLongDoubleReference) {
   EXPECT_EQ(checked, 22);
 }
 
+// Joint strips, the overlaps of a dry joint: two faces nearly parallel, pressed by 1e-2 to
+// 1e-5 of their length, each end of the strip at a corner of c, of t or of both (slivers of
+// the sub-triangles next to the face), tilted and moved away from the origin. The forces sum to zero with zero moment, swapping the
+// triangles swaps them, they are minus the gradient of the energy (central differences, steps
+// of 1e-3 of the depth), and the energy matches the long-double reference to the rounding
+// bound.
+TEST(NarrowPhase, JointStripsBalanceAndAreConservative) {
+  const double L = 0.2, Ep = 5.556e12, angle = -1.1, ox = -3.7, oy = 8.9;
+  auto place = [&](double x, double y) {
+    return Vec2{ox + std::cos(angle) * x - std::sin(angle) * y,
+                oy + std::sin(angle) * x + std::cos(angle) * y};
+  };
+  int checked = 0;
+  for (const double left : {-0.1, 0.0, 0.12})      // c's left end beyond, at, inside t's
+    for (const double right : {-0.07, 0.0, 0.09})  // same at the right end
+      for (const int e : {2, 3, 5}) {
+        const double d = L * std::pow(10.0, -e);
+        const Tri t = {place(0.0, 0.0), place(0.45 * L, -0.8 * L), place(L, 0.0)};
+        const Tri c = {place(left * L, -d), place((1.0 - right) * L, -d * (1.0 + 2e-2)),
+                       place(0.6 * L, 0.75 * L)};
+        const PairForce f = triangle_pair_force(c, t, Ep);
+        ASSERT_GT(f.area, 0.0);
+        const double ref = static_cast<double>(energy_ld(c, t, Ep));
+        EXPECT_NEAR(f.energy, ref, strip_tolerance(d, L) * ref) << left << " " << right << " " << e;
+        const double scale = force_scale(f);
+        EXPECT_NEAR(sum_x(f), 0.0, 1e-12 * scale);
+        EXPECT_NEAR(sum_y(f), 0.0, 1e-12 * scale);
+        EXPECT_NEAR(total_moment(c, t, f), 0.0, 1e-11 * scale * 10.0);  // lever arm ~ 10
+        const PairForce g = triangle_pair_force(t, c, Ep);
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_NEAR(g.on_t[k].x, f.on_c[k].x, 1e-10 * scale);
+          EXPECT_NEAR(g.on_t[k].y, f.on_c[k].y, 1e-10 * scale);
+          EXPECT_NEAR(g.on_c[k].x, f.on_t[k].x, 1e-10 * scale);
+          EXPECT_NEAR(g.on_c[k].y, f.on_t[k].y, 1e-10 * scale);
+        }
+        const double step = 1e-3 * d;
+        for (int which = 0; which < 2; ++which)
+          for (int k = 0; k < 3; ++k)
+            for (int axis = 0; axis < 2; ++axis) {
+              Tri cp = c, cm = c, tp = t, tm = t;
+              Tri& P = which == 0 ? cp : tp;
+              Tri& Mi = which == 0 ? cm : tm;
+              (axis == 0 ? P[k].x : P[k].y) += step;
+              (axis == 0 ? Mi[k].x : Mi[k].y) -= step;
+              const double dE = (triangle_pair_force(cp, tp, Ep).energy -
+                                 triangle_pair_force(cm, tm, Ep).energy) /
+                                (2 * step);
+              const Vec2 fk = which == 0 ? f.on_c[k] : f.on_t[k];
+              EXPECT_NEAR(-dE, axis == 0 ? fk.x : fk.y, 1e-6 * scale)
+                  << left << " " << right << " d/L 1e-" << e << " tri " << which << " node " << k
+                  << " axis " << axis;
+            }
+        ++checked;
+      }
+  EXPECT_EQ(checked, 27);
+}
+
 // Energy is never negative, whatever the overlap: random thin and deep overlaps.
 TEST(NarrowPhase, EnergyNeverNegative) {
   std::mt19937_64 rng(777);
