@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "contact/friction.hpp"
@@ -57,6 +58,36 @@ double force_scale(const PairForce& f) {
   for (int k = 0; k < 3; ++k)
     s += std::hypot(f.on_c[k].x, f.on_c[k].y) + std::hypot(f.on_t[k].x, f.on_t[k].y);
   return s;
+}
+
+// Swapping the triangles swaps the forces (g: the pair evaluated as (t, c)).
+void expect_swapped(const PairForce& f, const PairForce& g, double tol) {
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(g.on_t[k].x, f.on_c[k].x, tol);
+    EXPECT_NEAR(g.on_t[k].y, f.on_c[k].y, tol);
+    EXPECT_NEAR(g.on_c[k].x, f.on_t[k].x, tol);
+    EXPECT_NEAR(g.on_c[k].y, f.on_t[k].y, tol);
+  }
+}
+
+// f = -dE/dx for every one of the 12 coordinates (central differences of `step`).
+void expect_conservative(const Tri& c, const Tri& t, double Ep, const PairForce& f, double step,
+                         double tol, const std::string& what) {
+  for (int which = 0; which < 2; ++which)
+    for (int k = 0; k < 3; ++k)
+      for (int axis = 0; axis < 2; ++axis) {
+        Tri cp = c, cm = c, tp = t, tm = t;
+        Tri& P = which == 0 ? cp : tp;
+        Tri& Mi = which == 0 ? cm : tm;
+        (axis == 0 ? P[k].x : P[k].y) += step;
+        (axis == 0 ? Mi[k].x : Mi[k].y) -= step;
+        const double dE =
+            (triangle_pair_force(cp, tp, Ep).energy - triangle_pair_force(cm, tm, Ep).energy) /
+            (2 * step);
+        const Vec2 fk = which == 0 ? f.on_c[k] : f.on_t[k];
+        EXPECT_NEAR(-dE, axis == 0 ? fk.x : fk.y, tol)
+            << what << " tri " << which << " node " << k << " axis " << axis;
+      }
 }
 
 }  // namespace
@@ -190,30 +221,8 @@ TEST(NarrowPhase, RandomPairsBalanceSwapAndAreConservative) {
     const PairForce g = triangle_pair_force(t, c, Ep);
     EXPECT_NEAR(g.area, f.area, 1e-10 * f.area);
     EXPECT_NEAR(g.energy, f.energy, 1e-10 * f.energy);
-    for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(g.on_t[k].x, f.on_c[k].x, 1e-10 * scale);
-      EXPECT_NEAR(g.on_t[k].y, f.on_c[k].y, 1e-10 * scale);
-      EXPECT_NEAR(g.on_c[k].x, f.on_t[k].x, 1e-10 * scale);
-      EXPECT_NEAR(g.on_c[k].y, f.on_t[k].y, 1e-10 * scale);
-    }
-
-    // f = -dE/dx for every one of the 12 coordinates.
-    const double step = 1e-6;
-    for (int which = 0; which < 2; ++which)
-      for (int k = 0; k < 3; ++k)
-        for (int axis = 0; axis < 2; ++axis) {
-          Tri cp = c, cm = c, tp = t, tm = t;
-          Tri& P = which == 0 ? cp : tp;
-          Tri& Mi = which == 0 ? cm : tm;
-          (axis == 0 ? P[k].x : P[k].y) += step;
-          (axis == 0 ? Mi[k].x : Mi[k].y) -= step;
-          const double dE =
-              (triangle_pair_force(cp, tp, Ep).energy - triangle_pair_force(cm, tm, Ep).energy) /
-              (2 * step);
-          const Vec2 fk = which == 0 ? f.on_c[k] : f.on_t[k];
-          EXPECT_NEAR(-dE, axis == 0 ? fk.x : fk.y, 1e-5 * scale)
-              << "trial " << trial << " tri " << which << " node " << k << " axis " << axis;
-        }
+    expect_swapped(f, g, 1e-10 * scale);
+    expect_conservative(c, t, Ep, f, 1e-6, 1e-5 * scale, "trial " + std::to_string(trial));
   }
   EXPECT_GE(tested, 100);
 }
@@ -406,30 +415,10 @@ TEST(NarrowPhase, JointStripsBalanceAndAreConservative) {
         EXPECT_NEAR(sum_x(f), 0.0, 1e-12 * scale);
         EXPECT_NEAR(sum_y(f), 0.0, 1e-12 * scale);
         EXPECT_NEAR(total_moment(c, t, f), 0.0, 1e-11 * scale * 10.0);  // lever arm ~ 10
-        const PairForce g = triangle_pair_force(t, c, Ep);
-        for (int k = 0; k < 3; ++k) {
-          EXPECT_NEAR(g.on_t[k].x, f.on_c[k].x, 1e-10 * scale);
-          EXPECT_NEAR(g.on_t[k].y, f.on_c[k].y, 1e-10 * scale);
-          EXPECT_NEAR(g.on_c[k].x, f.on_t[k].x, 1e-10 * scale);
-          EXPECT_NEAR(g.on_c[k].y, f.on_t[k].y, 1e-10 * scale);
-        }
-        const double step = 1e-3 * d;
-        for (int which = 0; which < 2; ++which)
-          for (int k = 0; k < 3; ++k)
-            for (int axis = 0; axis < 2; ++axis) {
-              Tri cp = c, cm = c, tp = t, tm = t;
-              Tri& P = which == 0 ? cp : tp;
-              Tri& Mi = which == 0 ? cm : tm;
-              (axis == 0 ? P[k].x : P[k].y) += step;
-              (axis == 0 ? Mi[k].x : Mi[k].y) -= step;
-              const double dE = (triangle_pair_force(cp, tp, Ep).energy -
-                                 triangle_pair_force(cm, tm, Ep).energy) /
-                                (2 * step);
-              const Vec2 fk = which == 0 ? f.on_c[k] : f.on_t[k];
-              EXPECT_NEAR(-dE, axis == 0 ? fk.x : fk.y, 1e-6 * scale)
-                  << left << " " << right << " d/L 1e-" << e << " tri " << which << " node " << k
-                  << " axis " << axis;
-            }
+        expect_swapped(f, triangle_pair_force(t, c, Ep), 1e-10 * scale);
+        expect_conservative(c, t, Ep, f, 1e-3 * d, 1e-6 * scale,
+                            std::to_string(left) + " " + std::to_string(right) + " d/L 1e-" +
+                                std::to_string(e));
         ++checked;
       }
   EXPECT_EQ(checked, 27);
