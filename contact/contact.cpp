@@ -65,6 +65,10 @@ namespace {
 // threads than on one on the loaded 2-core machine. Parallel pairs pay only on large scenes.
 constexpr std::size_t kParallelPairs = 8192;
 
+// Values of the impact dashpot's state per pair: the x and y of the pair's six potential nodal
+// forces of the last step.
+constexpr std::size_t kDampedValues = 12;
+
 // Corner slots per pair on the threaded path: [6 p + 2 k + side], side 0 for corner k of the
 // pair's first triangle c, 1 for the second t (the order in which the one-thread loop adds them).
 constexpr int kPairSlots = 6;
@@ -154,10 +158,12 @@ struct ContactSystem::Impl {
   std::vector<IndexPair> pairs, next_pairs;
   std::vector<double> sx, sy, kt, next_sx, next_sy;
   // Joint stiffness (contact/joint_stiffness.hpp): per-pair penalty x thickness [Pa m] when
-  // `joints`; impact damping: per-pair beta [s] and |f| of the last step [N] when `damping`,
-  // and per node the damping force of this and of the last step (for the ledger's trapezoid).
+  // `joints`; impact damping: per-pair beta [s] and the pair's potential nodal forces of the
+  // last step [N] (kDampedValues per pair: on_c then on_t, x and y, corner by corner; zero
+  // while the pair does not touch) when `damping`, and per node the damping force of this and
+  // of the last step (for the ledger's trapezoid).
   bool joints = false, damping = false;
-  std::vector<double> ep_thick, beta, prev_fn, next_prev_fn, scratch;
+  std::vector<double> ep_thick, beta, prev_f, next_prev_f;
   TrackedForce impact;  // the dashpots' nodal forces (when `damping`)
   // Friction (mu > 0): its nodal forces, and the slip springs' stored energy sum 1/2 k_t s^2
   // of the last step [J]. The ledger books as dissipated the work the friction forces take
@@ -221,7 +227,7 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
   s.damping = params.restitution < 1.0;
   s.ep_thick.clear();
   s.beta.clear();
-  s.prev_fn.clear();
+  s.prev_f.clear();
   s.impact.reset(s.damping ? model.nodes.x.size() : 0);
   s.friction.reset(params.friction > 0.0 ? model.nodes.x.size() : 0);
   s.stored_prev = 0.0;
@@ -272,8 +278,8 @@ void ContactSystem::detect(const Model& model) {
   s.broad.detect(model.nodes, s.next_pairs);
   carry_friction_history(s.pairs, s.sx, s.sy, s.next_pairs, s.next_sx, s.next_sy);
   if (s.damping) {
-    carry_friction_history(s.pairs, s.prev_fn, s.prev_fn, s.next_pairs, s.next_prev_fn, s.scratch);
-    std::swap(s.prev_fn, s.next_prev_fn);
+    carry_pair_values(s.pairs, s.prev_f, kDampedValues, s.next_pairs, s.next_prev_f);
+    std::swap(s.prev_f, s.next_prev_f);
   }
   std::swap(s.pairs, s.next_pairs);
   std::swap(s.sx, s.next_sx);
@@ -292,7 +298,7 @@ void ContactSystem::Impl::index_pairs(const Model& model) {
   const double scale = kTangentialStiffnessRatio * penalty * thickness;
   const bool mapped = joints || params.shear_stiffness > 0.0 || damping;
   if (joints) ep_thick.resize(np);
-  if (damping) beta.resize(np), prev_fn.resize(np, 0.0);
+  if (damping) beta.resize(np), prev_f.resize(kDampedValues * np, 0.0);
   const double zeta = restitution_damping_ratio(params.restitution);
   for (std::size_t p = 0; p < np; ++p) {
     const Index a = pairs[p].a, b = pairs[p].b;
@@ -381,16 +387,20 @@ void ContactSystem::Impl::record_detection(const Nodes& nodes) {
 
 // State bytes: u64 tag, u8 ready, u8 detected, i64 detections, i64 active, then the arrays
 // detected_x, detected_y, pairs, sx, sy (each u64 count then the items); from tag 2 on, the
-// impact damping's prev_fn (per pair) and its last nodal forces x and y (per node), empty
-// without it; from tag 3 on, friction's last nodal forces x and y (per node, empty without
-// friction) and its springs' stored energy of the last step (f64). A state of tag 1 or 2 with
-// friction restarts with those at zero and the stored energy of its slips: its first step books
-// the friction work of half a step less than an uninterrupted run (the ledger only).
+// impact damping's per-pair state and its last nodal forces x and y (per node), empty without
+// it; from tag 3 on, friction's last nodal forces x and y (per node, empty without friction)
+// and its springs' stored energy of the last step (f64). The per-pair damping state is, from
+// tag 4 on, the pair's last potential nodal forces (kDampedValues per pair); tags 2 and 3 held
+// |f| of the former dashpot on the force's magnitude, so their states restart only without
+// impact damping. A state of tag 1 or 2 with friction restarts with those at zero and the
+// stored energy of its slips: its first step books the friction work of half a step less than
+// an uninterrupted run (the ledger only).
 namespace {
 
 constexpr std::uint64_t kStateTag1 = 0x564f555353434f31ull;  // "VOUSSCO1": no damping arrays
 constexpr std::uint64_t kStateTag2 = 0x564f555353434f32ull;  // "VOUSSCO2": no friction arrays
-constexpr std::uint64_t kStateTag = 0x564f555353434f33ull;   // "VOUSSCO3"
+constexpr std::uint64_t kStateTag3 = 0x564f555353434f33ull;  // "VOUSSCO3": |f| dashpot state
+constexpr std::uint64_t kStateTag = 0x564f555353434f34ull;   // "VOUSSCO4"
 
 void put_bytes(std::vector<char>& out, const void* p, std::size_t n) {
   const std::size_t at = out.size();
@@ -447,7 +457,7 @@ std::vector<char> ContactSystem::save_state() const {
   put_array(out, s.pairs);
   put_array(out, s.sx);
   put_array(out, s.sy);
-  put_array(out, s.prev_fn);
+  put_array(out, s.prev_f);
   put_array(out, s.impact.prev_x);
   put_array(out, s.impact.prev_y);
   put_array(out, s.friction.prev_x);
@@ -460,21 +470,22 @@ void ContactSystem::restore_state(const Model& model, const std::vector<char>& b
   Impl& s = *impl_;
   StateReader in{bytes};
   const auto tag = in.get<std::uint64_t>();
-  if (tag != kStateTag && tag != kStateTag2 && tag != kStateTag1) in.fail("not a contact state");
+  if (tag != kStateTag && tag != kStateTag3 && tag != kStateTag2 && tag != kStateTag1)
+    in.fail("not a contact state");
   const bool ready = in.get<std::uint8_t>() != 0, detected = in.get<std::uint8_t>() != 0;
   const auto detections = in.get<std::int64_t>(), active = in.get<std::int64_t>();
   std::vector<double> dx = in.get_array<double>(), dy = in.get_array<double>();
   std::vector<IndexPair> pairs = in.get_array<IndexPair>();
   std::vector<double> sx = in.get_array<double>(), sy = in.get_array<double>();
-  std::vector<double> prev_fn, fd_prev_x, fd_prev_y, ff_prev_x, ff_prev_y;
+  std::vector<double> prev_f, fd_prev_x, fd_prev_y, ff_prev_x, ff_prev_y;
   bool has_friction_state = false;
   double stored_prev = 0.0;
   if (tag != kStateTag1) {
-    prev_fn = in.get_array<double>();
+    prev_f = in.get_array<double>();
     fd_prev_x = in.get_array<double>();
     fd_prev_y = in.get_array<double>();
   }
-  if (tag == kStateTag) {
+  if (tag == kStateTag || tag == kStateTag3) {
     ff_prev_x = in.get_array<double>();
     ff_prev_y = in.get_array<double>();
     stored_prev = in.get<double>();
@@ -517,8 +528,12 @@ void ContactSystem::restore_state(const Model& model, const std::vector<char>& b
   s.sx = std::move(sx);
   s.sy = std::move(sy);
   if (s.damping) {
-    if (prev_fn.size() != s.pairs.size()) in.fail("impact damping and pair counts differ");
-    s.prev_fn = std::move(prev_fn);
+    if (tag != kStateTag)
+      in.fail("written by an earlier version, whose impact dashpot (contact.restitution < 1) "
+              "kept another state: restart from the deck");
+    if (prev_f.size() != kDampedValues * s.pairs.size())
+      in.fail("impact damping and pair counts differ");
+    s.prev_f = std::move(prev_f);
     s.impact.prev_x = std::move(fd_prev_x);
     s.impact.prev_y = std::move(fd_prev_y);
   }
@@ -578,7 +593,7 @@ inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double 
   apart = apart || overlap_negligible(cv, tv);
   if (apart) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;  // contact lost: history cleared
-    if (damping) prev_fn[p] = 0.0;
+    if (damping) std::fill_n(prev_f.data() + kDampedValues * p, kDampedValues, 0.0);
     return false;
   }
   return evaluate_overlap<kFriction>(p, n, dt, r);
@@ -601,7 +616,7 @@ template <bool kFriction>
   const PairForce f = triangle_pair_force(cv, tv, joints ? ep_thick[p] : penalty * thickness);
   if (!(f.area > 0.0)) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;
-    if (damping) prev_fn[p] = 0.0;
+    if (damping) std::fill_n(prev_f.data() + kDampedValues * p, kDampedValues, 0.0);
     return false;
   }
   r.energy = f.energy;
@@ -611,13 +626,15 @@ template <bool kFriction>
     r.on_t[k] = {f.on_t[k].x, f.on_t[k].y};
   }
   if (damping) {
-    // Impact dashpot on the rate of |f| along f (contact/joint_stiffness.hpp).
-    const double fn = std::hypot(f.resultant.x, f.resultant.y);
-    const double scale = fn > 0.0 ? beta[p] * (fn - prev_fn[p]) / (dt * fn) : 0.0;
-    prev_fn[p] = fn;
+    // Impact dashpot on the rate of each nodal force of the potential (contact/
+    // joint_stiffness.hpp): beta (f^n - f^(n-1)) / dt, f^(n-1) = 0 at the first touch.
+    double* q = prev_f.data() + kDampedValues * p;
+    const double rate = beta[p] / dt;
     for (int k = 0; k < 3; ++k) {
-      r.damp_c[k] = {scale * f.on_c[k].x, scale * f.on_c[k].y};
-      r.damp_t[k] = {scale * f.on_t[k].x, scale * f.on_t[k].y};
+      r.damp_c[k] = {rate * (f.on_c[k].x - q[4 * k]), rate * (f.on_c[k].y - q[4 * k + 1])};
+      r.damp_t[k] = {rate * (f.on_t[k].x - q[4 * k + 2]), rate * (f.on_t[k].y - q[4 * k + 3])};
+      q[4 * k] = f.on_c[k].x, q[4 * k + 1] = f.on_c[k].y;
+      q[4 * k + 2] = f.on_t[k].x, q[4 * k + 3] = f.on_t[k].y;
       r.on_c[k].x += r.damp_c[k].x, r.on_c[k].y += r.damp_c[k].y;
       r.on_t[k].x += r.damp_t[k].x, r.on_t[k].y += r.damp_t[k].y;
     }

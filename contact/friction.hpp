@@ -95,4 +95,10 @@ void carry_friction_history(const std::vector<IndexPair>& prev, const std::vecto
                             const std::vector<double>& prev_sy, const std::vector<IndexPair>& next,
                             std::vector<double>& next_sx, std::vector<double>& next_sy);
 
+// The same for `width` values per pair (prev_values[width p .. width p + width)), e.g. the
+// impact dashpot's last nodal forces (contact/contact.cpp).
+void carry_pair_values(const std::vector<IndexPair>& prev, const std::vector<double>& prev_values,
+                       std::size_t width, const std::vector<IndexPair>& next,
+                       std::vector<double>& next_values);
+
 }  // namespace voussoir

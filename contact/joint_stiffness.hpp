@@ -45,17 +45,27 @@
 // joint of length L bounces on the spring K = kn t_z L; a dashpot of damping ratio
 //     zeta = -ln e / sqrt(pi^2 + ln^2 e)          (zeta = 1 at e = 0)
 // returns it with e times its approach speed (the linear spring-dashpot result). The dashpot
-// acts on the rate of the pair's normal force, in the force's own direction:
-//     f_d = beta d|f|/dt  f / |f|,    beta = 2 zeta / omega,   omega^2 = kn t_z L / m_eff,
-// which on the flat joint is the dashpot c = 2 zeta sqrt(K m_eff) on the normal relative
-// velocity (d|f|/dt = K v_n), follows the actual contact when only part of the joint touches
-// (rocking), and vanishes for a rigid motion of the pair (|f| unchanged when the pair only
-// turns). m_eff = m_c m_t / (m_c + m_t) of the two blocks (m_c against a fixed block),
-// L = min of the two blocks' extents along the facing edge. The rate is the backward
-// difference (|f|^n - |f|^(n-1)) / dt, the damping at the lagging velocity, as the element
-// damping of core/cst.hpp. Its work is booked by the trapezoid over each position increment,
+// is stiffness-proportional: on each node of the pair it acts on the rate of that node's
+// potential force,
+//     f_d,i = beta df_i/dt,    beta = 2 zeta / omega,   omega^2 = kn t_z L / m_eff,
+// i.e. beta K_c v for the pair's contact stiffness K_c: on the flat drop it is the dashpot
+// c = 2 zeta sqrt(K m_eff) on the normal relative velocity, and it damps every motion the
+// joint resists, the rocking of a block on its joint as well (the pressure moving across the
+// joint with |f| unchanged). A rigid motion of a touching pair turns its forces and so costs
+// beta omega_body |f|, small beside |f| as beta is of the order of the joint's period. m_eff = m_c m_t / (m_c + m_t)
+// of the two blocks (m_c against a fixed block), L = min of the two blocks' extents along the
+// facing edge. The rate is the backward difference (f_i^n - f_i^(n-1)) / dt, f^(n-1) = 0 when
+// the pair did not touch, the damping at the lagging velocity, as the element damping of
+// core/cst.hpp; the last forces are per-pair state, carried across re-detection and
+// checkpoints. Its work is booked by the trapezoid over each position increment,
 // 1/2 (f_d^n + f_d^(n-1)) . (x^n - x^(n-1)), per node (contact/contact.cpp), so the ledger
 // stays exact to O(dt^2).
+// Replaced (session 9): the same beta on the rate of the pair's force magnitude, along the
+// force, d|f|/dt f / |f|. It left the rocking of a block on its joint undamped: a block
+// rocking onto its corner kept 0.968 of its angular velocity at e = 0 (Housner: 0.912; now
+// 0.941), and the sliding semicircular arch of the regression, whose joints chatter, gave
+// lambda* 1.1650 at e = 0.5 and 1.1694 at e = 0 against 1.1825 with elastic blocks (now
+// 1.1738 and 1.1781; docs/rigid.md).
 
 #include <utility>
 #include <vector>

