@@ -28,10 +28,6 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
-bool quasi_static_trials(const Config& config, bool asked) {
-  return asked && config.material.model != "rigid";
-}
-
 SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet) {
   const auto t0 = Clock::now();
   SettledState s;
@@ -133,7 +129,9 @@ RunSpec trial_spec(const SettledState& settled, double lambda, const TrialCriter
   spec.limits = crit.limits;
   spec.track_motion = true;
   spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
-  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time));
+  auto rest = std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time);
+  if (crit.quasi_static) rest->refuse_creep(d_collapse, crit.collapse_rotation, kCreepTolerance);
+  spec.rules.push_back(std::move(rest));
   spec.rules.push_back(std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0,
                                                    crit.ramp_time, crit.max_time));
   spec.quiet = quiet;
@@ -233,6 +231,8 @@ std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
     f.value(s.sim.ctx.local_damping_outgoing ? 1.0 : 0.0);
   }
   if (c.direction != 1.0) f.value(c.direction);
+  // The quasi-static trials' rest rule refuses a creep (RestRule::refuse_creep).
+  if (c.quasi_static) f.value(kCreepTolerance);
   // The contact law: the settled positions need not show a change of friction or joint
   // stiffness (a block at rest under gravity alone sits the same at any friction).
   const ContactParams& cp = s.sim.contact.params();

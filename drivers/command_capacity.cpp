@@ -188,7 +188,7 @@ int command_capacity(const Config& config, const CommonOptions& common,
   }
   TrialCriteria criteria = opts.criteria;
   criteria.limits = common.limits;
-  criteria.quasi_static = quasi_static_trials(config, !opts.dynamic);
+  criteria.quasi_static = !opts.dynamic;
   CapacitySearch search;
   search.points = opts.points;
   search.quiet = common.quiet;

@@ -95,9 +95,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
     CapacityResult r;
     std::string error;
     try {
-      TrialCriteria cell = criteria;  // quasi-static for elastic blocks only
-      cell.quasi_static = quasi_static_trials(configs[c], criteria.quasi_static);
-      r = find_capacity(configs[c], cell, opts.points, true);
+      r = find_capacity(configs[c], criteria, opts.points, true);
     } catch (const std::exception& e) {
       error = e.what();
     }

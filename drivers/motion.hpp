@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <vector>
 
@@ -98,6 +99,38 @@ class RestDetector {
   double v_rest_, hold_;
   bool require_decay_;
   std::vector<Sample> window_;
+};
+
+// Creep: a motion that is slow but does not stop. The motion measure m (max(d / d_scale,
+// rot / rot_scale) of the free blocks since the start of the run: 1 at the collapse
+// criterion) has grown by more than `tolerance` over the last `hold` of run time. A decaying
+// motion passes below any tolerance once it has settled; a steady creep (a sliding mechanism
+// that a damping force holds back, docs/capacity.md) never does. Samples come in time order;
+// with less than `hold` of them the motion counts as creeping (not yet known to have stopped).
+class CreepDetector {
+ public:
+  CreepDetector(double hold, double tolerance) : hold_(hold), tolerance_(tolerance) {}
+  void add(double t, double m) {
+    history_.push_back({t, m});
+    // Keep one sample at or before t - hold (the start of the window).
+    while (history_.size() > 2 && history_[1].t <= t - hold_)
+      history_.pop_front();
+  }
+  // Growth of m over the last hold window (the last sample against the one at or just before
+  // its start); infinity while the history is shorter than the window.
+  double growth() const {
+    if (history_.empty() || history_.back().t - history_.front().t < hold_ * (1.0 - 1e-9))
+      return std::numeric_limits<double>::infinity();
+    return history_.back().m - history_.front().m;
+  }
+  bool creeping() const { return !(growth() <= tolerance_); }
+
+ private:
+  struct Sample {
+    double t, m;
+  };
+  double hold_, tolerance_;
+  std::deque<Sample> history_;
 };
 
 }  // namespace voussoir

@@ -149,7 +149,10 @@ std::optional<Verdict> CollapseRule::check(const Probe& p) {
 
 std::optional<Verdict> RestRule::check(const Probe& p) {
   if (p.time < from_) return std::nullopt;
-  if (detector_.update(p.time, p.speed, p.sim.ledger.kinetic)) return Verdict{false, "rest"};
+  const bool still = detector_.update(p.time, p.speed, p.sim.ledger.kinetic);
+  // A refused rest is retried at the next sample: the speed window stays open.
+  if (creep_) creep_->add(p.time, std::max(p.motion.displacement / d_, p.motion.rotation / rot_));
+  if (still && !(creep_ && creep_->creeping())) return Verdict{false, "rest"};
   return std::nullopt;
 }
 

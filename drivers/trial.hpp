@@ -24,7 +24,10 @@
 //   CollapseRule  collapsed when a free block's centroid moved more than d_limit or rotated
 //                 more than rot_limit since the start of the run;
 //   RestRule      stable when the largest free-node speed has stayed below v_rest for the hold
-//                 window (RestDetector, drivers/motion.hpp), from run time `from` on;
+//                 window (RestDetector, drivers/motion.hpp), from run time `from` on; with
+//                 refuse_creep (the capacity trials), also when the motion measure has grown
+//                 by at most a tolerance over that window (CreepDetector): a steady creep,
+//                 however slow, is not rest;
 //   TrendRule     at run time `limit` (and not before `from`): collapsed when the motion
 //                 measure max(d / d_scale, rot / rot_scale) now exceeds by 10% its largest
 //                 value over the first two thirds of the samples since `measure_from`, stable
@@ -121,12 +124,23 @@ class RestRule : public StopRule {
  public:
   // require_decay: RestDetector's growth check (off for the pulses: speed alone).
   RestRule(double v_rest, double hold, double from, bool require_decay = true)
-      : detector_(v_rest, hold, require_decay), from_(from) {}
+      : detector_(v_rest, hold, require_decay), hold_(hold), from_(from) {}
+  // Also refuse a creep (CreepDetector, drivers/motion.hpp): rest needs the motion measure
+  // max(d / d_scale, rot / rot_scale) to have grown by at most `tolerance` over the hold
+  // window. Needs RunSpec::track_motion.
+  RestRule& refuse_creep(double d_scale, double rot_scale, double tolerance) {
+    d_ = d_scale;
+    rot_ = rot_scale;
+    creep_.emplace(hold_, tolerance);
+    return *this;
+  }
   std::optional<Verdict> check(const Probe& p) override;
 
  private:
   RestDetector detector_;
-  double from_;
+  double hold_, from_;
+  double d_ = 1.0, rot_ = 1.0;
+  std::optional<CreepDetector> creep_;
 };
 
 class TrendRule : public StopRule {

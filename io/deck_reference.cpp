@@ -100,7 +100,7 @@ const std::map<std::string, std::string>& meanings() {
       {"capacity.tolerance", "relative width of the final bracket: (hi - lo) / hi"},
       {"capacity.local_damping",
        "coefficient of the local damping of the quasi-static settle and trials of `capacity` "
-       "and `sweep`, elastic blocks only (0: none; `--dynamic`: off; docs/capacity.md)"},
+       "and `sweep` (0: none; `--dynamic`: off; docs/capacity.md)"},
       {"capacity.local_damping_mode",
        "outgoing: damp only while the force opposes the motion (a mechanism is not slowed); "
        "full: Cundall's rule at every step"},
