@@ -18,8 +18,8 @@ struct ContactParams {
   double buffer = 0.0;    // NBS buffer [m]; 0 = automatic (a fraction of the smallest element)
   // Joint stiffness in engineering units (contact/joint_stiffness.hpp). normal_stiffness kn
   // [N/m3] > 0 replaces the single penalty by one per pair that gives kn on a flat joint;
-  // joint_young E [Pa] > 0 (and kn = 0) takes kn = 100 E / l per pair instead (the rigid-block
-  // default, contact/joint_stiffness.hpp). shear_stiffness ks [N/m3]: tangential spring of the
+  // joint_young E [Pa] > 0 (and kn = 0) takes kn = 100 E / L per pair instead (L: the
+  // joint's length; the rigid-block default, contact/joint_stiffness.hpp). shear_stiffness ks [N/m3]: tangential spring of the
   // friction law; 0 = 1/4 of the normal stiffness (kTangentialStiffnessRatio).
   double normal_stiffness = 0.0;
   double joint_young = 0.0;
@@ -78,7 +78,7 @@ class ContactSystem {
   // The same for rigid blocks (Model::rigid): from the joints' stiffness and the bodies' mass
   // and rotational inertia (contact/joint_stiffness.hpp).
   ContactFrequencyBound rigid_frequency_bound(const Model& model) const;
-  // True when the pairs carry their own penalty from a joint stiffness (kn or E / l).
+  // True when the pairs carry their own penalty from a joint stiffness (kn or 100 E / L).
   bool joint_stiffness_mode() const;
 
   // Candidate pairs from which add_forces runs on threads (default 8192, contact/contact.cpp

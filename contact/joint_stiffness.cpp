@@ -77,10 +77,11 @@ std::pair<FacingEdge, FacingEdge> facing_edges(const Model& model, Index c, Inde
 }
 
 double default_joint_stiffness(double young, const Block& a, const Block* b, const Vec2& normal) {
-  const double la = extent_along(a.polygon, normal);
-  if (b == nullptr || b->fixed) return kRigidJointFactor * young / la;
-  const double lb = extent_along(b->polygon, normal);
-  return kRigidJointFactor * young / (a.fixed ? lb : 0.5 * (la + lb));
+  const Vec2 tangent{-normal.y, normal.x};
+  double length = extent_along(a.polygon, tangent);
+  if (b != nullptr && !b->polygon.empty())
+    length = std::min(length, extent_along(b->polygon, tangent));
+  return kRigidJointFactor * young / length;
 }
 
 double joint_frequency(double kn_thickness, const Block& a, double mass_a, const Block* b,

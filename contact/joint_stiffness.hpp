@@ -24,18 +24,28 @@
 // centroid; under a block on a wide ground triangle it picked the block's side, a 25% softer
 // joint.)
 //
-// Default for rigid blocks (no stiffness given): kn = kRigidJointFactor x E / l, with l the
-// length of the joint's blocks normal to the joint: half of each of two free blocks,
-// l = (l_c + l_t) / 2, and the whole free block against a fixed one, l = l_c. l_b is the
-// extent of block b's outline along the facing edge's normal. E / l alone is UDEC practice
-// (it lumps the blocks' uniform compression into the joints, so a column of rigid blocks is as
-// stiff as the elastic one), but a hinge does not compress a block uniformly: the thrust
-// crowds into a contact zone whose width shrinks as the joint stiffens, and the softer the
-// joint the wider that zone and the further inside the section the pivot. Measured on the
-// semicircular arch (docs/rigid.md): lambda* = 0.2792, 0.2879, 0.2923, 0.2945 at kn = 1, 10,
-// 100, 1000 x E / l against 0.2947 with elastic blocks; the factor 100 is the first decade
-// within 1% of the elastic blocks. It sets the step (dt ~ 1 / sqrt(kn)): a user who knows the
-// joints gives contact.normal_stiffness.
+// Default for rigid blocks (no stiffness given): kn = kRigidJointFactor x E / L, with L the
+// length of the joint: the shorter of the two blocks' extents along the facing edge (the
+// free block's alone against a support with no outline). Why the joint's length and not the
+// blocks' length l normal to the joint (E / l, UDEC practice, which lumps the blocks' uniform
+// compression into the joints so that a column of rigid blocks is as stiff as the elastic
+// one; our default until session 10): what decides lambda* is the hinge, and a hinge does
+// not compress a block uniformly. The thrust N crowds into a contact zone of width c at the
+// pivot; on a joint of stiffness kn rotating by theta, N = kn theta c^2 / 2, so
+//     c / L = sqrt(2 N / (theta kn L^2)) ~ sqrt(sigma / (theta kn L)),    sigma = N / L,
+// and the lever arm the softness takes away, relative to the section, depends on kn L, not
+// on kn l: for the same masonry the pivot moves as much whatever the blocks' length normal to
+// the joint. (The rotational stiffness of a rigid strip of width L on an elastic half-space
+// is ~E L^2 too, so E / L is also the joint that rotates like the blocks' own material.) So
+// kn L = kRigidJointFactor x E at every joint. With E / l, thin blocks on a long joint (the
+// churches' 0.08 m voussoirs on 0.5 m joints) got joints 6 times stiffer than an arch of
+// squarer voussoirs, and a step 2.5 times shorter, for no gain in the hinge; tall blocks on a
+// short joint (the buttresses, 3 m high on a 0.8 m base) got joints 4 times softer, and
+// lambda* of the buttressed arches 1.1 to 1.9% below the elastic blocks' (now 0.3 to 0.8%).
+// The factor: on the semicircular arch (docs/rigid.md) lambda* = 0.2792, 0.2879, 0.2923,
+// 0.2945 at kn = 1, 10, 100, 1000 x E / l (l = 0.29 m, L = 0.2 m there) against 0.2947 with
+// elastic blocks; 100 is the first decade within 1% of the elastic blocks. The default sets
+// the step (dt ~ 1 / sqrt(kn)): a user who knows the joints gives contact.normal_stiffness.
 //
 // Shear: the friction law's tangential spring (contact/friction.hpp) acts at one point of the
 // pair: kt = ks t_z min(L_c, L_t), the shear stiffness of the longest flat contact the two
@@ -74,7 +84,7 @@
 
 namespace voussoir {
 
-// kn = kRigidJointFactor x E / l for rigid blocks with no stiffness given (above).
+// kn = kRigidJointFactor x E / L for rigid blocks with no stiffness given (above).
 inline constexpr double kRigidJointFactor = 100.0;
 
 // One triangle's facing edge (reference configuration).
@@ -93,8 +103,8 @@ double extent_along(const std::vector<Vec2>& polygon, const Vec2& direction);
 // Damping ratio of the restitution e in [0, 1] (above); 0 at e = 1.
 double restitution_damping_ratio(double e);
 
-// kn = kRigidJointFactor x E / l of a joint of unit normal `normal` between block a and block b
-// (b == nullptr: a fixed support with no outline) [N/m3] (above).
+// kn = kRigidJointFactor x E / L of a joint of unit normal `normal` between block a and block b
+// (b == nullptr or without outline: a fixed support; L from a alone) [N/m3] (above).
 double default_joint_stiffness(double young, const Block& a, const Block* b, const Vec2& normal);
 
 // Joint frequency sqrt(kn t_z L / m_eff) [1/s] (above): L the shorter of the two blocks'
@@ -111,7 +121,7 @@ struct PairJoint {
   double omega = 0.0;  // joint frequency [1/s] (above)
 };
 
-// kn_given > 0: that stiffness; else young > 0: E / l (above); else penalty mode: kn from the
+// kn_given > 0: that stiffness; else young > 0: 100 E / L (above); else penalty mode: kn from the
 // single penalty Ep (kn = Ep (3/h_c + 3/h_t)). ks_given = 0: kTangentialStiffnessRatio x kn.
 PairJoint pair_joint(const Model& model, Index c, Index t, double kn_given, double young,
                      double penalty, double ks_given, double thickness);

@@ -75,7 +75,8 @@ struct ContactConfig {
   double penalty = 0.0;                // Ep [Pa]; 0 = use penalty_factor
   double buffer = 0.0;                 // NBS buffer [m]; 0 = automatic
   // Joint stiffness [N/m3] (contact/joint_stiffness.hpp); 0 = not given: the penalty for
-  // elastic blocks, kn = 100 E / l for rigid ones; shear 0 = 1/4 of the normal stiffness.
+  // elastic blocks, kn = 100 E / L for rigid ones (L: the joint's length); shear 0 = 1/4 of
+  // the normal stiffness.
   double normal_stiffness = 0.0;
   double shear_stiffness = 0.0;
   double restitution = 1.0;            // impact restitution in [0, 1]; 1 = no impact damping

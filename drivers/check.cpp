@@ -105,7 +105,7 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                       : kTangentialStiffnessRatio * config.contact.normal_stiffness);
     else
       std::printf(
-          "joints      kn = %g E / l per joint (l: the blocks' length normal to it), ks = %s\n",
+          "joints      kn = %g E / L per joint (L: the joint's length), ks = %s\n",
           kRigidJointFactor,
           config.contact.shear_stiffness > 0.0 ? "contact.shear_stiffness" : "kn / 4");
   } else {

@@ -40,8 +40,8 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   cp.normal_stiffness = config.contact.normal_stiffness;
   cp.shear_stiffness = config.contact.shear_stiffness;
   cp.restitution = config.contact.restitution;
-  // Rigid blocks with neither a stiffness nor a penalty given: kn = 100 E / l per joint
-  // (contact/joint_stiffness.hpp).
+  // Rigid blocks with neither a stiffness nor a penalty given: kn = 100 E / L per joint (L:
+  // its length; contact/joint_stiffness.hpp).
   if (rigid && !(cp.normal_stiffness > 0.0) && !config.contact.has("penalty") &&
       !config.contact.has("penalty_factor"))
     cp.joint_young = config.material.young;

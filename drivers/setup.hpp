@@ -19,7 +19,7 @@ struct SetupInfo {
   double penalty = 0.0;      // contact penalty Ep [Pa]
   double eta = 0.0;          // damping viscosity [Pa s]
   bool rigid = false;        // material.model = "rigid"
-  bool joint_stiffness = false;  // pairs carry a joint stiffness (kn or E / l)
+  bool joint_stiffness = false;  // pairs carry a joint stiffness (kn or 100 E / L)
   std::string dt_set_by;     // what sets the stable step
 };
 

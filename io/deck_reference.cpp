@@ -72,8 +72,8 @@ const std::map<std::string, std::string>& meanings() {
       {"contact.penalty", "contact penalty Ep as a value (0: from contact.penalty_factor)"},
       {"contact.buffer", "NBS contact search buffer (0: automatic)"},
       {"contact.normal_stiffness",
-       "joint normal stiffness kn, replaces the penalty (not given: penalty, or 100 E / l for "
-       "rigid blocks)"},
+       "joint normal stiffness kn, replaces the penalty (not given: penalty, or 100 E / L for "
+       "rigid blocks, L the joint's length)"},
       {"contact.shear_stiffness", "joint shear stiffness ks (not given: kn / 4)"},
       {"contact.restitution",
        "impact restitution of rigid blocks (1: no impact damping; below 1 needs "
