@@ -50,11 +50,12 @@ Snapshot run(const std::string& deck, const std::vector<std::string>& overrides,
   return Snapshot{n.x, n.y, n.vx, n.vy, sim.ledger};
 }
 
-// Church A at `through_thickness` after `steps` steps under gravity and lambda = 0.3: a
-// general, moving state.
+// Church A with elastic blocks at `through_thickness` after `steps` steps under gravity and
+// lambda = 0.3: a general, moving state.
 Simulation moving_church(int through_thickness, int steps) {
   const Config config = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/church_a.toml",
-                                  {"mesh.through_thickness=" + std::to_string(through_thickness)});
+                                  {"material.model=elastic",
+                                   "mesh.through_thickness=" + std::to_string(through_thickness)});
   Simulation sim = make_simulation(config);
   set_static_load(sim, 9.81, 0.3);
   for (int k = 0; k < steps; ++k) advance(sim);
@@ -96,7 +97,7 @@ TEST(Threads, ArchOneAndTwoThreadsBitIdentical) {
 }
 
 TEST(Threads, LargeChurchOneAndTwoThreadsBitIdentical) {
-  const std::vector<std::string> set = {"mesh.through_thickness=6"};
+  const std::vector<std::string> set = {"material.model=elastic", "mesh.through_thickness=6"};
   const Snapshot one = run("church_a.toml", set, 200, 1);
   ASSERT_GE(one.x.size(), 8192u);  // above the element and integration thresholds
   const Snapshot two = run("church_a.toml", set, 200, 2);
