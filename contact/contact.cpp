@@ -914,11 +914,12 @@ bool ContactSystem::joint_stiffness_mode() const {
 // each side of its outline as a face against a fixed support. With impact damping, the
 // dashpots (beta K, contact/joint_stiffness.hpp) damp that mode at the rate beta_b omega^2,
 // beta_b the largest of b's joints; the body with the shortest damped step sets it.
-ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) const {
+std::vector<ContactFrequencyBound> ContactSystem::rigid_body_bounds(const Model& model) const {
   const Impl& s = *impl_;
   const RigidBodies& r = model.rigid;
   const std::size_t nb = model.blocks.size();
-  if (!s.ready || r.mass.size() != nb) return {};
+  std::vector<ContactFrequencyBound> bounds(nb);
+  if (!s.ready || r.mass.size() != nb) return bounds;
   std::vector<Eigen::Matrix3d> stiffness(nb, Eigen::Matrix3d::Zero());
   std::vector<double> beta_max(nb, 0.0);
   std::vector<char> has_face(nb, 0);
@@ -973,8 +974,6 @@ ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) c
     for (std::size_t k = 0; k < poly.size(); ++k)
       add_face(Index(b), -1, poly[k], poly[(k + 1) % poly.size()]);
   }
-  ContactFrequencyBound worst;
-  double worst_step = std::numeric_limits<double>::infinity();
   for (std::size_t b = 0; b < nb; ++b) {
     if (!has_face[b]) continue;
     const Eigen::Vector3d inv_sqrt_m(1.0 / std::sqrt(r.mass[b]), 1.0 / std::sqrt(r.mass[b]),
@@ -982,12 +981,21 @@ ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) c
     const Eigen::Matrix3d scaled = inv_sqrt_m.asDiagonal() * stiffness[b] * inv_sqrt_m.asDiagonal();
     const double lambda =
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scaled).eigenvalues().maxCoeff();
-    const double rate = beta_max[b] * lambda;
-    const double g = 0.5 * rate;
-    const double step = 2.0 / (g + std::sqrt(lambda + g * g));
+    bounds[b] = {lambda, beta_max[b] * lambda};
+  }
+  return bounds;
+}
+
+ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) const {
+  ContactFrequencyBound worst;
+  double worst_step = std::numeric_limits<double>::infinity();
+  for (const ContactFrequencyBound& c : rigid_body_bounds(model)) {
+    if (!(c.omega_squared > 0.0)) continue;
+    const double g = 0.5 * c.damping_rate;
+    const double step = 2.0 / (g + std::sqrt(c.omega_squared + g * g));
     if (step < worst_step) {
       worst_step = step;
-      worst = {lambda, rate};
+      worst = c;
     }
   }
   return worst;

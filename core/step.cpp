@@ -83,6 +83,20 @@ double stable_time_step(const Simulation& sim) {
   return damped_stable_step(omega_squared, el.damping_rate);
 }
 
+std::vector<double> rigid_body_stable_steps(const Simulation& sim) {
+  if (!sim.model.is_rigid()) return {};
+  std::vector<double> steps(sim.model.blocks.size(), std::numeric_limits<double>::infinity());
+  if (!sim.ctx.contact_on) return steps;
+  const std::vector<ContactFrequencyBound> bounds = sim.contact.rigid_body_bounds(sim.model);
+  for (std::size_t b = 0; b < bounds.size(); ++b) {
+    const ContactFrequencyBound& c = bounds[b];
+    if (!(c.omega_squared > 0.0)) continue;
+    const double fraction = c.damping_rate > 0.0 ? kRigidDampedStepFraction : kRigidStepFraction;
+    steps[b] = fraction * damped_stable_step(c.omega_squared, c.damping_rate);
+  }
+  return steps;
+}
+
 void advance(Simulation& sim) {
   Model& model = sim.model;
   StepContext& ctx = sim.ctx;

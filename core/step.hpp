@@ -69,6 +69,11 @@ void prepare_context(Simulation& sim, double damping_factor);
 
 // Stable time step [s] of the model (elements and, when on, contact), before the safety factor.
 double stable_time_step(const Simulation& sim);
+// Rigid blocks: the stable limit of each block alone on its joints [s], with the step fraction
+// of stable_time_step (whose value is the smallest of these); infinity for a fixed block or
+// one without joints, empty for elastic blocks. For `check`: how far the blocks' own limits
+// spread (mass scaling of the fast ones could only gain that much).
+std::vector<double> rigid_body_stable_steps(const Simulation& sim);
 
 // Advances the simulation by ctx.dt. Energy ledger: strain and kinetic energy at the step
 // (core/integrate.hpp for the leapfrog K), external work and damping dissipation by the

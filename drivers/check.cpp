@@ -1,7 +1,10 @@
 // `voussoir check DECK`: validate the deck, build the model, print its summary (SPEC.md
 // section 2) and optionally the meshed geometry as JSON for scripts/draw.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "contact/friction.hpp"
@@ -97,6 +100,20 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                                              : "elastic (constant-strain triangles)");
   std::printf("dt          %.4g s (stable limit %.4g s, set by the %s)\n", info.dt, info.dt_stable,
               info.dt_set_by.c_str());
+  // Rigid blocks: how far the blocks' own stable limits spread. The step is the smallest; a
+  // narrow spread means that no mass scaling of a few fast blocks could lengthen it much.
+  const std::vector<double> each_body = rigid_body_stable_steps(sim);
+  std::vector<double> body_steps;
+  for (double s : each_body)
+    if (std::isfinite(s)) body_steps.push_back(s);
+  std::sort(body_steps.begin(), body_steps.end());
+  const std::size_t fastest =
+      std::size_t(std::min_element(each_body.begin(), each_body.end()) - each_body.begin());
+  if (!body_steps.empty()) {
+    std::printf("body steps  min %.4g s (block %zu), median %.4g s, max %.4g s: each free block "
+                "alone on its joints\n",
+                body_steps.front(), fastest, body_steps[body_steps.size() / 2], body_steps.back());
+  }
   if (info.joint_stiffness) {
     if (config.contact.normal_stiffness > 0.0)
       std::printf("joints      kn = %.4g N/m3, ks = %.4g N/m3\n", config.contact.normal_stiffness,
@@ -130,6 +147,11 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                         {"joints", m.joints.size()},
                         {"block_model", info.rigid ? "rigid" : "elastic"},
                         {"dt_set_by", info.dt_set_by}};
+    if (!body_steps.empty())
+      j["body_steps"] = {{"min", body_steps.front()},
+                         {"min_block", fastest},
+                         {"median", body_steps[body_steps.size() / 2]},
+                         {"max", body_steps.back()}};
     if (named) {
       nlohmann::json names = nlohmann::json::array();
       for (const Block& b : m.blocks) names.push_back(b.name);

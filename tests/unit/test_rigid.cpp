@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -334,6 +335,28 @@ TEST(Rigid, StableStepIsSetByTheJointsNotTheElements) {
            &damped);
   EXPECT_LT(damped.dt, kRigidDampedStepFraction / kRigidStepFraction * soft.dt);
   EXPECT_GT(damped.dt, 0.9 * kRigidDampedStepFraction / kRigidStepFraction * soft.dt);
+}
+
+TEST(Rigid, EachBodysOwnStepBoundsTheModelsStep) {
+  // The buttressed arch: voussoirs and buttress courses of different sizes. The model's step
+  // is the smallest of the blocks' own limits (the figure `check` prints beside it), the
+  // fixed ground has none, and elastic blocks report none.
+  const std::string arch =
+      "[model]\nkind = \"buttressed_arch\"\nshape = \"circular\"\nembrace = 180\n[material]\nmodel = \"rigid\"\n";
+  for (const char* restitution : {"contact.restitution=1", "contact.restitution=0.5"}) {
+    Simulation sim = deck_sim(arch, {restitution});
+    const std::vector<double> steps = rigid_body_stable_steps(sim);
+    ASSERT_EQ(steps.size(), sim.model.blocks.size());
+    double smallest = std::numeric_limits<double>::infinity(), largest = 0.0;
+    for (std::size_t b = 0; b < steps.size(); ++b) {
+      EXPECT_EQ(std::isfinite(steps[b]), !sim.model.blocks[b].fixed) << b;
+      smallest = std::min(smallest, steps[b]);
+      if (std::isfinite(steps[b])) largest = std::max(largest, steps[b]);
+    }
+    EXPECT_EQ(smallest, stable_time_step(sim)) << restitution;
+    EXPECT_GT(largest, smallest);
+  }
+  EXPECT_TRUE(rigid_body_stable_steps(deck_sim(arch, {"material.model=elastic"})).empty());
 }
 
 void expect_refused(const std::string& text, const std::vector<std::string>& sets,
