@@ -913,7 +913,8 @@ bool ContactSystem::joint_stiffness_mode() const {
 // over its whole length. A free block with no joint (one that falls onto something) gets
 // each side of its outline as a face against a fixed support. With impact damping, the
 // dashpots (beta K, contact/joint_stiffness.hpp) damp that mode at the rate beta_b omega^2,
-// beta_b the largest of b's joints; the body with the shortest damped step sets it.
+// beta_b the largest of b's joints; the body with the shortest damped step sets it
+// (core/step.cpp stable_time_step).
 std::vector<ContactFrequencyBound> ContactSystem::rigid_body_bounds(const Model& model) const {
   const Impl& s = *impl_;
   const RigidBodies& r = model.rigid;
@@ -984,21 +985,6 @@ std::vector<ContactFrequencyBound> ContactSystem::rigid_body_bounds(const Model&
     bounds[b] = {lambda, beta_max[b] * lambda};
   }
   return bounds;
-}
-
-ContactFrequencyBound ContactSystem::rigid_frequency_bound(const Model& model) const {
-  ContactFrequencyBound worst;
-  double worst_step = std::numeric_limits<double>::infinity();
-  for (const ContactFrequencyBound& c : rigid_body_bounds(model)) {
-    if (!(c.omega_squared > 0.0)) continue;
-    const double g = 0.5 * c.damping_rate;
-    const double step = 2.0 / (g + std::sqrt(c.omega_squared + g * g));
-    if (step < worst_step) {
-      worst_step = step;
-      worst = c;
-    }
-  }
-  return worst;
 }
 
 }  // namespace voussoir

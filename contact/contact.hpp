@@ -75,11 +75,9 @@ class ContactSystem {
   // Largest effective contact stiffness per unit nodal mass, for the stable time step:
   // omega_max^2 estimate [1/s2].
   double max_omega_squared(const Model& model) const;
-  // The same for rigid blocks (Model::rigid): from the joints' stiffness and the bodies' mass
-  // and rotational inertia (contact/joint_stiffness.hpp).
-  ContactFrequencyBound rigid_frequency_bound(const Model& model) const;
-  // The same bound for each block on its own (zero for a fixed block or one without faces):
-  // rigid_frequency_bound is the one of these with the shortest stable step.
+  // The same for rigid blocks (Model::rigid), block by block: each body on its joints, from
+  // their stiffness and its mass and rotational inertia (contact/joint_stiffness.hpp); zero
+  // for a fixed block or one without faces. The model's step is the shortest of theirs.
   std::vector<ContactFrequencyBound> rigid_body_bounds(const Model& model) const;
   // True when the pairs carry their own penalty from a joint stiffness (kn or 100 E / L).
   bool joint_stiffness_mode() const;

@@ -35,7 +35,7 @@
 
 namespace voussoir {
 
-// Steps per joint period. The joint bound (contact/contact.cpp rigid_frequency_bound) is the
+// Steps per joint period. The joint bound (contact/contact.cpp rigid_body_bounds) is the
 // exact highest frequency of the flat joints, not a bound 2 to 4 times above it as for elastic
 // blocks, and a one-sided contact integrated near omega dt = 2 gains energy each time it
 // opens and closes (a hinge opening, a block lifting off at the top of its bounce): the

@@ -3,10 +3,12 @@
 
 #include "core/step.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <vector>
 
 #include "core/cst.hpp"
 #include "core/integrate.hpp"
@@ -63,17 +65,16 @@ void prepare_context(Simulation& sim, double damping_factor) {
 // (min(2/omega_el, 2/omega_c)) can exceed the true limit by up to sqrt(2).
 //
 // Rigid blocks have no element modes: the bound is the contact one over the bodies' mass and
-// rotational inertia (contact/contact.hpp rigid_frequency_bound), and the damping rate that of
-// the contact's impact damping (restitution < 1), if any, times kRigidStepFraction, or
+// rotational inertia, block by block (contact/contact.hpp rigid_body_bounds; the smallest of
+// rigid_body_stable_steps), the damping rate that of the contact's impact damping
+// (restitution < 1), if any, times kRigidStepFraction, or
 // kRigidDampedStepFraction with impact damping (core/rigid.hpp: the joints' one-sided contact
 // and their dashpots must be resolved, not only kept stable).
 double stable_time_step(const Simulation& sim) {
   if (sim.model.is_rigid()) {
-    const ContactFrequencyBound c =
-        sim.ctx.contact_on ? sim.contact.rigid_frequency_bound(sim.model) : ContactFrequencyBound{};
-    if (!(c.omega_squared > 0.0)) return std::numeric_limits<double>::infinity();
-    const double fraction = c.damping_rate > 0.0 ? kRigidDampedStepFraction : kRigidStepFraction;
-    return fraction * damped_stable_step(c.omega_squared, c.damping_rate);
+    const std::vector<double> steps = rigid_body_stable_steps(sim);
+    return steps.empty() ? std::numeric_limits<double>::infinity()
+                         : *std::min_element(steps.begin(), steps.end());
   }
   const CstFrequencyBound el = max_frequency_bound(sim.model, law_of(sim.ctx));
   double omega_squared = el.omega_squared;

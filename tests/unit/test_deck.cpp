@@ -295,9 +295,9 @@ TEST(Deck, SetOverridesParseAsTomlValues) {
 }
 
 TEST(Deck, SetIsValidatedLikeTheFile) {
-  const std::string bad_value = expect_deck_error(
+  expect_deck_error(
       kMinimal, {"--set", "model.embrace = 400", "(0, 360)"}, {"model.embrace=400"});
-  const std::string bad_path = expect_deck_error(
+  expect_deck_error(
       kMinimal, {"unknown key 'model.embrase'", "--set model.embrase=135", "'model.embrace'"},
       {"model.embrase=135"});
   expect_deck_error(kMinimal, {"--set 'model.embrace'", "expected KEY=VALUE"}, {"model.embrace"});
