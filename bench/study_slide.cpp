@@ -16,7 +16,10 @@
 // --qs-settle A / --qs-trial A: Cundall local damping coefficient of the settle / of the trial
 // (0, the default: physical); --qs-off T: the trial's local damping switched off at trial time
 // T; --end: trial length [s] (default 1.5); --every: sampling period [s] (default 0.01);
-// --joint: joints to print (default: the two springings).
+// --joint: joints to print (default: the two springings). With --qs-settle, the kinetic
+// damping of the deck's capacity.kinetic_damping acts in the settle and the trial as in
+// `capacity` (--set capacity.kinetic_damping=0: the local damping alone), and the rest rule
+// refuses a creep as there.
 
 #include <cmath>
 #include <cstdio>
@@ -89,7 +92,12 @@ int main(int argc, char** argv) {
   spec.track_motion = true;
   spec.limits.drift_limit = 0.5;
   spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
-  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time));
+  {
+    // As capacity's quasi-static trials: the rest rule refuses a creep.
+    auto rest = std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time);
+    if (qs_trial > 0.0) rest->refuse_creep(d_collapse, crit.collapse_rotation, kCreepTolerance);
+    spec.rules.push_back(std::move(rest));
+  }
   spec.rules.push_back(std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0,
                                                    crit.ramp_time, crit.max_time));
   spec.min_time = end;

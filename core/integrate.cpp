@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/parallel.hpp"
+#include "core/rigid.hpp"
 
 namespace voussoir {
 
@@ -114,6 +115,33 @@ double integrate_central_difference(Model& model, double dt, LocalDamping& dampi
       });
   damping.dissipated = sums.y;
   return 0.5 * sums.x;
+}
+
+double apply_kinetic_damping(Model& model, double kinetic, double dt, KineticDamping& damping) {
+  if (kinetic > damping.peak) {
+    damping.peak = kinetic;
+    return 0.0;
+  }
+  if (!(kinetic < (1.0 - damping.drop) * damping.peak)) return 0.0;
+  damping.peak = 0.0;
+  Nodes& n = model.nodes;
+  RigidBodies& r = model.rigid;
+  for (std::size_t b = 0; b < model.blocks.size(); ++b) {
+    const Block& blk = model.blocks[b];
+    if (blk.fixed) continue;
+    if (!r.empty()) {
+      if (!(r.mass[b] > 0.0)) continue;
+      set_rigid_state(model, Index(b), r.cx[b] - dt * r.vx[b], r.cy[b] - dt * r.vy[b],
+                      r.theta[b] - dt * r.omega[b], 0.0, 0.0, 0.0);
+      continue;
+    }
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+      n.x[i] -= dt * n.vx[i];
+      n.y[i] -= dt * n.vy[i];
+      n.vx[i] = n.vy[i] = 0.0;
+    }
+  }
+  return kinetic;
 }
 
 }  // namespace voussoir

@@ -44,6 +44,34 @@ struct LocalDamping {
   double dissipated = 0.0;                  // out: energy dissipated by this step [J]
 };
 
+// Kinetic damping (the velocity reset of dynamic relaxation), used with the local damping by
+// the quasi-static phases of `capacity` and `sweep` (docs/capacity.md, "Kinetic damping"):
+// the total kinetic energy K^n is followed step by step, and once it has fallen below
+// (1 - drop) times its largest value since the last reset, the step is taken back to x^n
+// with every free velocity set to zero (nodes, and the rigid bodies' translation and
+// rotation). A structure swinging towards an equilibrium has its largest K where it crosses
+// that equilibrium, so the reset stops it there instead of letting it overshoot, whatever the
+// period of the swing; the outgoing local damping takes only 1 - 1/sqrt(1 + alpha) of a
+// swing's speed per half-swing (26% at alpha = 0.8), which leaves the slow sway of a tall
+// structure ringing for several periods. A mechanism that the load accelerates has a growing
+// K and is never touched.
+//
+// Ledger: with v^(n+1/2) = 0 and x^(n+1) = x^n, the next step books K^(n+1) = 0, the same
+// U and no work over the (empty) increment, so the reset takes exactly K^n out of the stored
+// energy; K^n is booked as dissipated by the quasi-static damping (EnergyLedger::
+// local_dissipated) and the balance closes. (Zeroing the velocities after the position update
+// instead leaves the last increment's work unbooked: an O(1) balance error on a mode with a
+// few steps per period.)
+struct KineticDamping {
+  double drop = 0.0;  // relative fall of K below its peak that triggers a reset; 0: off
+  double peak = 0.0;  // largest K since the last reset [J] (state, kept by the Simulation)
+};
+
+// Follows K^n = `kinetic` after the central-difference update of step n (of length dt); on a
+// reset takes the positions back to x^n, sets every free velocity to zero and returns the
+// kinetic energy removed (`kinetic`), otherwise 0.
+double apply_kinetic_damping(Model& model, double kinetic, double dt, KineticDamping& damping);
+
 // The damping force of one degree of freedom (above).
 inline double local_damping_force(double alpha, bool outgoing, double force, double velocity) {
   if (outgoing) return force * velocity < 0.0 ? alpha * force : 0.0;

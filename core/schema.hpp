@@ -120,6 +120,10 @@ struct CapacityConfig {
   // "outgoing": only while the force opposes the motion (a mechanism is not slowed down);
   // "full": Cundall's rule on every step (core/integrate.hpp LocalDamping)
   std::string local_damping_mode = "outgoing";
+  // Kinetic damping of the same phases (core/integrate.hpp KineticDamping): every velocity is
+  // set to zero once the kinetic energy has fallen this fraction below its peak; in [0, 1),
+  // 0 = off (docs/capacity.md "Kinetic damping")
+  double kinetic_damping = 1e-3;
 };
 
 struct OutputConfig {

@@ -154,6 +154,13 @@ void advance(Simulation& sim) {
     kinetic = rigid ? integrate_rigid_bodies(model, ctx.dt)
                     : integrate_central_difference(model, ctx.dt);
   }
+  if (ctx.kinetic_damping > 0.0) {
+    KineticDamping kd{ctx.kinetic_damping, sim.kinetic_peak};
+    const double removed = apply_kinetic_damping(model, kinetic, ctx.dt, kd);
+    sim.kinetic_peak = kd.peak;
+    ledger.local_dissipated += removed;
+    kinetic -= removed;
+  }
   clock.stamp(timers.integrate);
 
   // Energy ledger.

@@ -8,7 +8,8 @@
 //   4. contact forces (potential penalty + Coulomb friction)       contact/
 //   5. body loads (gravity, lambda g, base motion)                 core/loads
 //   6. central-difference integration (v then x), kinetic energy   core/integrate
-//      (with the local damping of the quasi-static phases when ctx.local_damping > 0)
+//      (with the local damping of the quasi-static phases when ctx.local_damping > 0, and
+//      their kinetic damping when ctx.kinetic_damping > 0)
 
 #include <array>
 #include <vector>
@@ -34,6 +35,10 @@ struct StepContext {
   // LocalDamping); 0 = off (every physical run)
   double local_damping = 0.0;
   bool local_damping_outgoing = true;  // LocalDamping::outgoing
+  // Kinetic damping of the quasi-static phases (core/integrate.hpp KineticDamping): the
+  // relative fall of the kinetic energy below its peak that sets the velocities to zero; 0 =
+  // off (every physical run)
+  double kinetic_damping = 0.0;
   // Body acceleration of the previous step, for the trapezoidal external work (core/loads.hpp);
   // set by advance(), not by drivers.
   double prev_body_ax = 0.0;
@@ -60,6 +65,9 @@ struct Simulation {
   // Local damping force of the previous step per degree of freedom (core/integrate.hpp
   // LocalDamping); empty while ctx.local_damping is 0.
   std::vector<double> local_damping_previous;
+  // Largest kinetic energy since the last kinetic-damping reset [J] (core/integrate.hpp
+  // KineticDamping); 0 while ctx.kinetic_damping is 0.
+  double kinetic_peak = 0.0;
   // Scratch of the threaded element stage (core/cst.hpp), built at the first large step.
   ElementWorkspace element_work;
 };

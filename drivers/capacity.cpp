@@ -35,6 +35,7 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   if (crit.quasi_static) {
     s.sim.ctx.local_damping = config.capacity.local_damping;
     s.sim.ctx.local_damping_outgoing = config.capacity.local_damping_mode == "outgoing";
+    s.sim.ctx.kinetic_damping = config.capacity.kinetic_damping;
   }
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
@@ -230,6 +231,7 @@ std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
     f.value(s.sim.ctx.local_damping);
     f.value(s.sim.ctx.local_damping_outgoing ? 1.0 : 0.0);
   }
+  if (s.sim.ctx.kinetic_damping > 0.0) f.value(s.sim.ctx.kinetic_damping);
   if (c.direction != 1.0) f.value(c.direction);
   // The quasi-static trials' rest rule refuses a creep (RestRule::refuse_creep).
   if (c.quasi_static) f.value(kCreepTolerance);

@@ -395,6 +395,7 @@ const std::vector<KeySpec>& key_table() {
       {"capacity.lambda_max", [](Reader& r, const toml::node& n, Config& c) { c.capacity.lambda_max = r.number(n, at_least(0)); }},
       {"capacity.local_damping", [](Reader& r, const toml::node& n, Config& c) { c.capacity.local_damping = r.number(n, {0, false, 1, true}, "local damping coefficient of the quasi-static trials"); }},
       {"capacity.local_damping_mode", [](Reader& r, const toml::node& n, Config& c) { c.capacity.local_damping_mode = r.choice(n, {"outgoing", "full"}); }},
+      {"capacity.kinetic_damping", [](Reader& r, const toml::node& n, Config& c) { c.capacity.kinetic_damping = r.number(n, {0, false, 1, true}, "fraction of the peak kinetic energy"); }},
       {"capacity.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.capacity.tolerance = r.number(n, {0, true, 1, true}, "relative bracket width"); }},
       // [output]
       {"output.file", [](Reader& r, const toml::node& n, Config& c) { c.output.file = r.string(n); }},

@@ -104,6 +104,9 @@ const std::map<std::string, std::string>& meanings() {
       {"capacity.local_damping_mode",
        "outgoing: damp only while the force opposes the motion (a mechanism is not slowed); "
        "full: Cundall's rule at every step"},
+      {"capacity.kinetic_damping",
+       "kinetic damping of the same phases: every velocity set to zero once the kinetic energy "
+       "has fallen this fraction below its peak (0: none; `--dynamic`: off; docs/capacity.md)"},
       // [output]
       {"output.file", "HDF5 file of `run` / `pulse` (XDMF beside it); empty: none"},
       {"output.every", "snapshot interval"},
@@ -191,6 +194,7 @@ std::string default_of(const std::string& key) {
       {"capacity.tolerance", number(c.capacity.tolerance)},
       {"capacity.local_damping", number(c.capacity.local_damping)},
       {"capacity.local_damping_mode", quoted(c.capacity.local_damping_mode)},
+      {"capacity.kinetic_damping", number(c.capacity.kinetic_damping)},
       {"output.file", "none"},
       {"output.every", number(c.output.every)},
       {"output.fields", list(c.output.fields, quoted)},

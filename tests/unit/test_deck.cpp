@@ -93,6 +93,7 @@ lambda_max = 1.5
 tolerance = 0.01
 local_damping = 0.6
 local_damping_mode = "full"
+kinetic_damping = 0.01
 
 [output]
 file = "run.h5"
@@ -196,6 +197,7 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.capacity.tolerance, 0.01);
   EXPECT_DOUBLE_EQ(c.capacity.local_damping, 0.6);
   EXPECT_EQ(c.capacity.local_damping_mode, "full");
+  EXPECT_DOUBLE_EQ(c.capacity.kinetic_damping, 0.01);
   EXPECT_EQ(c.output.file, "run.h5");  // output paths stay relative to the working directory
   EXPECT_DOUBLE_EQ(c.output.every, 0.02);
   EXPECT_EQ(c.output.fields, (std::vector<std::string>{"velocity", "stress"}));
