@@ -23,8 +23,10 @@
 // The thresholds are studied in docs/capacity.md. With TrialCriteria::quasi_static (the
 // default of `capacity` and `sweep`) the settle and the trials run with the local damping of
 // the deck's capacity.local_damping (core/integrate.hpp LocalDamping; docs/capacity.md
-// "Quasi-static decisions"), rigid and elastic blocks alike. On a rigid sliding mechanism the
-// damping does not arrest the slide, it slows it to a steady creep below the rest speed;
+// "Quasi-static decisions") and the kinetic damping of its capacity.kinetic_damping
+// (core/integrate.hpp KineticDamping: a slow sway stopped at its equilibrium), rigid and
+// elastic blocks alike. On a rigid sliding mechanism the damping does not arrest the slide,
+// it slows it to a steady creep below the rest speed;
 // before the creep check the rest rule took that creep for rest and lambda* of the sliding
 // semicircular arch at beta = 120 came out 11% above the limit analysis that bounds it, so
 // rigid blocks ran the physical trials until the check came in. TrialCriteria::direction
@@ -68,7 +70,8 @@ struct TrialCriteria {
   double max_time = 3.0;               // [s] of simulated time after settling
   double settle_max_time = 5.0;        // [s]; a collapse under gravity ends it sooner
   // Quasi-static settle and trials: Cundall's local damping with the deck's
-  // capacity.local_damping (docs/capacity.md). capacity and sweep set it unless --dynamic;
+  // capacity.local_damping and kinetic damping with its capacity.kinetic_damping
+  // (docs/capacity.md). capacity and sweep set it unless --dynamic;
   // false (the physical settle) for the pulse curve's and the stability map's settles.
   bool quasi_static = false;
   double direction = 1.0;              // of lambda g: +1 towards +x, -1 towards -x
