@@ -118,12 +118,13 @@ double integrate_central_difference(Model& model, double dt, LocalDamping& dampi
 }
 
 double apply_kinetic_damping(Model& model, double kinetic, double dt, KineticDamping& damping) {
-  if (kinetic > damping.peak) {
-    damping.peak = kinetic;
+  double& peak = *damping.peak;
+  if (kinetic > peak) {
+    peak = kinetic;
     return 0.0;
   }
-  if (!(kinetic < (1.0 - damping.drop) * damping.peak)) return 0.0;
-  damping.peak = 0.0;
+  if (!(kinetic < (1.0 - damping.drop) * peak)) return 0.0;
+  peak = 0.0;
   Nodes& n = model.nodes;
   RigidBodies& r = model.rigid;
   for (std::size_t b = 0; b < model.blocks.size(); ++b) {

@@ -63,8 +63,8 @@ struct LocalDamping {
 // instead leaves the last increment's work unbooked: an O(1) balance error on a mode with a
 // few steps per period.)
 struct KineticDamping {
-  double drop = 0.0;  // relative fall of K below its peak that triggers a reset; 0: off
-  double peak = 0.0;  // largest K since the last reset [J] (state, kept by the Simulation)
+  double drop = 0.0;        // relative fall of K below its peak that triggers a reset; 0: off
+  double* peak = nullptr;   // largest K since the last reset [J] (state kept by the caller)
 };
 
 // Follows K^n = `kinetic` after the central-difference update of step n (of length dt); on a

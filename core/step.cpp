@@ -155,9 +155,8 @@ void advance(Simulation& sim) {
                     : integrate_central_difference(model, ctx.dt);
   }
   if (ctx.kinetic_damping > 0.0) {
-    KineticDamping kd{ctx.kinetic_damping, sim.kinetic_peak};
+    KineticDamping kd{ctx.kinetic_damping, &sim.kinetic_peak};
     const double removed = apply_kinetic_damping(model, kinetic, ctx.dt, kd);
-    sim.kinetic_peak = kd.peak;
     ledger.local_dissipated += removed;
     kinetic -= removed;
   }
