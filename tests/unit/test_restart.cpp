@@ -37,7 +37,8 @@ constexpr double kEndTime = 0.012;  // [s], about 17000 steps
 
 Config arch(double friction, double end_time) {
   return load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml",
-                   {"mesh.through_thickness=1", "load.lambda=0.5", "contact.buffer=0.0001",
+                   {"material.model=elastic", "mesh.through_thickness=1", "load.lambda=0.5",
+                    "contact.buffer=0.0001",
                     "contact.friction=" + std::to_string(friction),
                     "solver.end_time=" + std::to_string(end_time), "output.every=0.002"});
 }
@@ -293,8 +294,8 @@ TEST(Restart, ProgramOptions) {
   Scratch s("voussoir_restart_cli");
   const std::string deck = std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml";
   const std::vector<std::string> base = {
-      VOUSSOIR_BINARY,     "run", deck, "-q", "--set", "mesh.through_thickness=1", "--set",
-      "contact.friction=0"};
+      VOUSSOIR_BINARY,     "run", deck, "-q", "--set", "material.model=elastic", "--set",
+      "mesh.through_thickness=1", "--set", "contact.friction=0"};
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = base;
     args.insert(args.end(), extra.begin(), extra.end());
