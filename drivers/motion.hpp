@@ -74,8 +74,10 @@ class RestDetector {
   bool update(double t, double v_max, double kinetic) {
     if (v_max >= v_rest_) {
       window_.clear();
+      slow_ = false;
       return false;
     }
+    if (!slow_) slow_since_ = t, slow_ = true;
     window_.push_back({t, kinetic});
     const double t0 = window_.front().t;
     if (t - t0 < hold_) return false;
@@ -91,6 +93,10 @@ class RestDetector {
     while (!window_.empty() && window_.front().t <= mid) window_.erase(window_.begin());
     return false;
   }
+  // The speed has stayed below v_rest for the hold window up to the last update at t, whatever
+  // the kinetic energy did.
+  bool slow_for_hold(double t) const { return slow_ && t - slow_since_ >= hold_; }
+  double rest_speed() const { return v_rest_; }
 
  private:
   struct Sample {
@@ -99,6 +105,8 @@ class RestDetector {
   double v_rest_, hold_;
   bool require_decay_;
   std::vector<Sample> window_;
+  bool slow_ = false;
+  double slow_since_ = 0.0;  // run time of the first slow sample of the current slow stretch
 };
 
 // Creep: a motion that is slow but does not stop. The motion measure m (max(d / d_scale,

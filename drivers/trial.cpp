@@ -153,7 +153,35 @@ std::optional<Verdict> RestRule::check(const Probe& p) {
   // A refused rest is retried at the next sample: the speed window stays open.
   if (creep_) creep_->add(p.time, std::max(p.motion.displacement / d_, p.motion.rotation / rot_));
   if (still && !(creep_ && creep_->creeping())) return Verdict{false, "rest"};
+  if (creep_ && going_back(p)) return Verdict{false, "rest"};
   return std::nullopt;
+}
+
+bool RestRule::going_back(const Probe& p) {
+  if (!p.motion_base || !(p.speed < detector_.rest_speed())) {
+    blocks_.clear();
+    return false;
+  }
+  const Model& model = p.sim.model;
+  const std::vector<BlockMotion>& base = *p.motion_base;
+  const std::vector<BlockMotion> now = block_motions(model);
+  BlockSample sample{p.time, std::vector<double>(now.size(), 0.0)};
+  for (std::size_t b = 0; b < now.size(); ++b) {
+    if (model.blocks[b].fixed) continue;
+    sample.measure[b] =
+        std::max(std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy) / d_,
+                 std::abs(now[b].rotation - base[b].rotation) / rot_);
+  }
+  blocks_.push_back(std::move(sample));
+  // Keep one sample at or before the start of the window.
+  while (blocks_.size() > 2 && blocks_[1].t <= p.time - hold_) blocks_.pop_front();
+  if (!detector_.slow_for_hold(p.time) || p.time - blocks_.front().t < hold_ * (1.0 - 1e-9))
+    return false;
+  const std::vector<double>& first = blocks_.front().measure;
+  const std::vector<double>& last = blocks_.back().measure;
+  for (std::size_t b = 0; b < last.size(); ++b)
+    if (last[b] > first[b]) return false;
+  return true;
 }
 
 std::optional<Verdict> TrendRule::check(const Probe& p) {
@@ -194,7 +222,10 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
   };
   auto probe_now = [&] {
     Probe p = clock_probe();
-    if (spec.track_motion) p.motion = largest_motion(sim.model, base);
+    if (spec.track_motion) {
+      p.motion = largest_motion(sim.model, base);
+      p.motion_base = &base;
+    }
     p.speed = max_free_speed(sim.model.nodes);
     return p;
   };

@@ -27,7 +27,9 @@
 //                 window (RestDetector, drivers/motion.hpp), from run time `from` on; with
 //                 refuse_creep (the capacity trials), also when the motion measure has grown
 //                 by at most a tolerance over that window (CreepDetector): a steady creep,
-//                 however slow, is not rest;
+//                 however slow, is not rest; and a slow structure going back (no block's
+//                 own motion measure has grown over the window) is rest, however its
+//                 kinetic energy grows;
 //   TrendRule     at run time `limit` (and not before `from`): collapsed when the motion
 //                 measure max(d / d_scale, rot / rot_scale) now exceeds by 10% its largest
 //                 value over the first two thirds of the samples since `measure_from`, stable
@@ -36,6 +38,7 @@
 // The guards and the user's limits (RunLimits) are built by the engine itself, so that every
 // run has them and a new limit is one field and one rule here.
 
+#include <deque>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -93,6 +96,8 @@ struct Probe {
   long long steps = 0;   // steps since the start of the run
   MotionExtent motion;   // since the start of the run (when RunSpec::track_motion)
   double speed = 0.0;    // largest free-node speed [m/s]
+  // The block motions `motion` is measured from (when RunSpec::track_motion), else null.
+  const std::vector<BlockMotion>* motion_base = nullptr;
 };
 
 struct Verdict {
@@ -128,6 +133,13 @@ class RestRule : public StopRule {
   // Also refuse a creep (CreepDetector, drivers/motion.hpp): rest needs the motion measure
   // max(d / d_scale, rot / rot_scale) to have grown by at most `tolerance` over the hold
   // window. Needs RunSpec::track_motion.
+  //
+  // With it, a structure going back is also at rest: slow for the whole hold window, and no
+  // free block's own motion measure (its displacement and rotation since the start of the run,
+  // scaled as above) has grown over the window. Its kinetic energy may grow meanwhile: a
+  // structure that the kinetic damping stopped past its equilibrium swings slowly back to it
+  // (docs/capacity.md, "A structure going back is at rest"). A mechanism under its constant
+  // load moves away from the start, so some block's measure grows.
   RestRule& refuse_creep(double d_scale, double rot_scale, double tolerance) {
     d_ = d_scale;
     rot_ = rot_scale;
@@ -137,10 +149,19 @@ class RestRule : public StopRule {
   std::optional<Verdict> check(const Probe& p) override;
 
  private:
+  // Records every free block's measure at this sample (slow samples only) and tells whether
+  // none has grown over the last hold window.
+  bool going_back(const Probe& p);
+
   RestDetector detector_;
   double hold_, from_;
   double d_ = 1.0, rot_ = 1.0;
   std::optional<CreepDetector> creep_;
+  struct BlockSample {
+    double t;
+    std::vector<double> measure;  // per block; 0 for fixed blocks
+  };
+  std::deque<BlockSample> blocks_;  // the slow samples of the last hold window and one before
 };
 
 class TrendRule : public StopRule {

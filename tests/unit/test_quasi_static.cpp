@@ -13,12 +13,14 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/rigid.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/trial.hpp"
 #include "io/deck.hpp"
 #include "limit/limit_analysis.hpp"
 #include "subprocess.hpp"
@@ -133,6 +135,82 @@ TEST(LocalDamping, DisturbedBlockComesToRestAndTheLedgerCloses) {
     EXPECT_GT(kinetic[0], 0.0);
     EXPECT_LT(kinetic[1], 1e-6 * kinetic[0]) << "outgoing " << outgoing;
   }
+}
+
+// The capacity trials' rest rule (drivers/trial.hpp RestRule with refuse_creep) on a stack of
+// two rigid blocks moved by hand, sampled every millisecond at a tenth of the rest speed with
+// a kinetic energy that grows at every sample: the decay check alone never calls that rest.
+// Going back (every block's displacement since the start shrinks) is rest after one hold
+// window; one block going back while the other moves away from the start is not, even when
+// the largest displacement shrinks (the creep check reads only that largest one).
+struct MovedByHand {
+  Simulation sim;
+  std::vector<BlockMotion> base;
+  std::vector<Index> blocks;
+  explicit MovedByHand(const std::string& deck) : sim(make_simulation(parse_deck(deck, "test"))) {
+    base = block_motions(sim.model);
+    for (Index b = 0; b < Index(sim.model.blocks.size()); ++b)
+      if (!sim.model.blocks[std::size_t(b)].fixed) blocks.push_back(b);
+  }
+  void shift(Index b, double ux) {
+    const RigidBodies& r = sim.model.rigid;
+    set_rigid_state(sim.model, b, r.cx0[b] + ux, r.cy0[b], 0.0, 0.0, 0.0, 0.0);
+  }
+};
+
+// Samples the rule for 0.3 s while `move(k)` places the blocks at sample k; the run time of
+// the rest verdict, or -1.
+template <class Move>
+double rest_time(MovedByHand& h, Move move) {
+  const double v_rest = 1e-3, hold = 0.1, d_scale = 0.01, rot_scale = 0.05;
+  RestRule rule(v_rest, hold, 0.0);
+  rule.refuse_creep(d_scale, rot_scale, kCreepTolerance);
+  for (int k = 0; k <= 300; ++k) {
+    move(k);
+    h.sim.ledger.kinetic = 1e-9 * (1.0 + k);  // growing at every sample
+    Probe p(h.sim);
+    p.time = 1e-3 * k;
+    p.motion = largest_motion(h.sim.model, h.base);
+    p.motion_base = &h.base;
+    p.speed = 0.1 * v_rest;
+    const std::optional<Verdict> v = rule.check(p);
+    if (v) {
+      EXPECT_FALSE(v->collapsed);
+      return p.time;
+    }
+  }
+  return -1.0;
+}
+
+TEST(RestRule, AStructureGoingBackIsAtRestWhileItsKineticEnergyGrows) {
+  const std::string deck =
+      "[model]\nkind = \"block\"\nwidth = 0.25\nheight = 1.0\nstack = 2\n[material]\nmodel = "
+      "\"rigid\"\n";
+  MovedByHand back(deck);
+  ASSERT_EQ(back.blocks.size(), 2u);
+  const double t = rest_time(back, [&](int k) {
+    back.shift(back.blocks[0], 2e-3 - 1e-6 * k);
+    back.shift(back.blocks[1], 3e-3 - 2e-6 * k);
+  });
+  EXPECT_GE(t, 0.1);
+  EXPECT_LE(t, 0.102);
+
+  MovedByHand away(deck);
+  EXPECT_LT(rest_time(away, [&](int k) {
+              away.shift(away.blocks[0], 2e-3 + 1e-6 * k);
+              away.shift(away.blocks[1], 3e-3 + 2e-6 * k);
+            }),
+            0.0);
+
+  // The upper block goes back from 3 mm and stays the largest motion; the lower one moves
+  // away from 1 mm, slowly enough for the creep check (5e-7 m per 0.1 s, against
+  // kCreepTolerance x 0.01 m).
+  MovedByHand mixed(deck);
+  EXPECT_LT(rest_time(mixed, [&](int k) {
+              mixed.shift(mixed.blocks[0], 1e-3 + 5e-9 * k);
+              mixed.shift(mixed.blocks[1], 3e-3 - 2e-6 * k);
+            }),
+            0.0);
 }
 
 // Kinetic damping (core/integrate.hpp KineticDamping). A body that the load accelerates has a
