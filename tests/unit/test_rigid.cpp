@@ -258,6 +258,54 @@ TEST(MinimalMesh, AnArcKeepsThePointsItsSagittaAsksFor) {
   EXPECT_EQ(ear_clip(fine).size(), fine.size() - 2);
 }
 
+TEST(MinimalMesh, AVeryLongArcTakesTheFastPathWithTheSameBound) {
+  // 16 degrees of an arch of radius 2000 m and thickness 0.2 m (a fuzzed deck), 1500 points on
+  // each face: above mesh/minimal.cpp's kFastOutline, so its fast paths (the hull's width,
+  // Douglas-Peucker). Every original point must still lie within the tolerance, 1% of the
+  // outline's width (its smallest extent across the normals of its sides, computed here point
+  // by point: 19.7 m, the arc's sagitta and the thickness), of the chord between the kept
+  // vertices around it, and the faces must lose most of their points.
+  const int per_face = 1500;
+  const double r_in = 1999.9, r_out = 2000.1, a1 = 16.0 * std::numbers::pi / 180.0;
+  std::vector<Vec2> outline;
+  for (int k = 0; k < per_face; ++k) {
+    const double a = a1 * k / (per_face - 1);
+    outline.push_back({r_out * std::cos(a), r_out * std::sin(a)});
+  }
+  for (int k = per_face - 1; k >= 0; --k) {
+    const double a = a1 * k / (per_face - 1);
+    outline.push_back({r_in * std::cos(a), r_in * std::sin(a)});
+  }
+  const std::vector<Vec2> s = simplify_outline(outline, 0.01);
+  ASSERT_GE(s.size(), 4u);
+  EXPECT_LT(s.size(), outline.size() / 5);
+  // The kept vertices are original points, in order: walk the outline between them.
+  std::vector<std::size_t> at;
+  for (std::size_t k = 0, j = 0; k < outline.size() && j < s.size(); ++k)
+    if (outline[k].x == s[j].x && outline[k].y == s[j].y) at.push_back(k), ++j;
+  ASSERT_EQ(at.size(), s.size());
+  const std::size_t n = outline.size();
+  double width = 1e300;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 &a = outline[k], &b = outline[(k + 1) % n];
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    double lo = 1e300, hi = -1e300;
+    for (const Vec2& p : outline) {
+      const double t = (p.x * (b.y - a.y) - p.y * (b.x - a.x)) / len;
+      lo = std::min(lo, t), hi = std::max(hi, t);
+    }
+    width = std::min(width, hi - lo);
+  }
+  EXPECT_NEAR(width, 2000.1 * (1.0 - std::cos(a1 / 2.0)) + 0.2, 0.01);
+  const double tol = 0.01 * width * (1.0 + 1e-9);
+  for (std::size_t j = 0; j < at.size(); ++j) {
+    const std::size_t a = at[j], b = at[(j + 1) % at.size()];
+    for (std::size_t k = (a + 1) % n; k != b; k = (k + 1) % n)
+      EXPECT_LE(distance_to_segment(outline[k], outline[a], outline[b]), tol) << k;
+  }
+  EXPECT_EQ(ear_clip(s).size(), s.size() - 2);
+}
+
 TEST(MinimalMesh, NonConvexBlockTriangulatesWithoutOverlap) {
   // A crown block with a notch in its intrados.
   const std::vector<Vec2> poly = {{-1, 0}, {0, 0.3}, {1, 0}, {1, 1}, {-1, 1}};
