@@ -9,7 +9,10 @@
 //     along a straight side deviate by zero and always go; an arc keeps as many points as its
 //     sagitta asks). The block's thickness is its smallest width (the smallest extent of the
 //     outline across any of its sides' normals). The vertex whose removal deviates least goes
-//     first, until none can go;
+//     first, until none can go. An outline of more than 256 vertices (a fuzzed arch of radius
+//     2000 m has thousands; the shipped decks at most 88) takes its convex hull's width and a
+//     Douglas-Peucker pass before that removal, with the same bound on every original point;
+//     the n^2 paths took a minute there (mesh/minimal.cpp kFastOutline);
 //   - triangulation: ear clipping, each time the ear whose smallest angle is largest (a
 //     quadrilateral gives 2 triangles, an n-gon n - 2).
 // Joints, roles and fixed flags are kept; a joint's end points are corners of both blocks,
