@@ -96,7 +96,8 @@ class RestDetector {
   // The speed has stayed below v_rest for the hold window up to the last update at t, whatever
   // the kinetic energy did.
   bool slow_for_hold(double t) const { return slow_ && t - slow_since_ >= hold_; }
-  double rest_speed() const { return v_rest_; }
+  // The last update's speed was below v_rest.
+  bool slow() const { return slow_; }
 
  private:
   struct Sample {

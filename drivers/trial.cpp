@@ -129,14 +129,22 @@ void LoadProgram::apply(Simulation& sim) const {
   sim.ctx.body_ay = -g;
 }
 
-MotionExtent largest_motion(const Model& model, const std::vector<BlockMotion>& base) {
+std::vector<MotionExtent> motions_since(const Model& model, const std::vector<BlockMotion>& base) {
   const std::vector<BlockMotion> now = block_motions(model);
-  MotionExtent m;
+  std::vector<MotionExtent> m(now.size());
   for (size_t b = 0; b < now.size(); ++b) {
     if (model.blocks[b].fixed) continue;
-    m.displacement =
-        std::max(m.displacement, std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy));
-    m.rotation = std::max(m.rotation, std::abs(now[b].rotation - base[b].rotation));
+    m[b] = {std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy),
+            std::abs(now[b].rotation - base[b].rotation)};
+  }
+  return m;
+}
+
+MotionExtent largest_of(const std::vector<MotionExtent>& blocks) {
+  MotionExtent m;
+  for (const MotionExtent& b : blocks) {
+    m.displacement = std::max(m.displacement, b.displacement);
+    m.rotation = std::max(m.rotation, b.rotation);
   }
   return m;
 }
@@ -158,20 +166,13 @@ std::optional<Verdict> RestRule::check(const Probe& p) {
 }
 
 bool RestRule::going_back(const Probe& p) {
-  if (!p.motion_base || !(p.speed < detector_.rest_speed())) {
+  if (!p.blocks || !detector_.slow()) {
     blocks_.clear();
     return false;
   }
-  const Model& model = p.sim.model;
-  const std::vector<BlockMotion>& base = *p.motion_base;
-  const std::vector<BlockMotion> now = block_motions(model);
-  BlockSample sample{p.time, std::vector<double>(now.size(), 0.0)};
-  for (std::size_t b = 0; b < now.size(); ++b) {
-    if (model.blocks[b].fixed) continue;
-    sample.measure[b] =
-        std::max(std::hypot(now[b].ux - base[b].ux, now[b].uy - base[b].uy) / d_,
-                 std::abs(now[b].rotation - base[b].rotation) / rot_);
-  }
+  BlockSample sample{p.time, std::vector<double>(p.blocks->size())};
+  for (std::size_t b = 0; b < sample.measure.size(); ++b)
+    sample.measure[b] = std::max((*p.blocks)[b].displacement / d_, (*p.blocks)[b].rotation / rot_);
   blocks_.push_back(std::move(sample));
   // Keep one sample at or before the start of the window.
   while (blocks_.size() > 2 && blocks_[1].t <= p.time - hold_) blocks_.pop_front();
@@ -220,11 +221,13 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
     p.steps = sim.step - step_start;
     return p;
   };
+  std::vector<MotionExtent> blocks;  // each block's motion at the sample
   auto probe_now = [&] {
     Probe p = clock_probe();
     if (spec.track_motion) {
-      p.motion = largest_motion(sim.model, base);
-      p.motion_base = &base;
+      blocks = motions_since(sim.model, base);
+      p.motion = largest_of(blocks);
+      p.blocks = &blocks;
     }
     p.speed = max_free_speed(sim.model.nodes);
     return p;

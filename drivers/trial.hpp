@@ -85,8 +85,11 @@ struct MotionExtent {
   double displacement = 0.0, rotation = 0.0;
 };
 
-// Largest motion of the free blocks of `model` since the block motions `base`.
-MotionExtent largest_motion(const Model& model, const std::vector<BlockMotion>& base);
+// Motion of each block of `model` since the block motions `base` (zero for fixed blocks).
+std::vector<MotionExtent> motions_since(const Model& model, const std::vector<BlockMotion>& base);
+
+// The largest displacement and the largest rotation among `blocks`.
+MotionExtent largest_of(const std::vector<MotionExtent>& blocks);
 
 // What the hooks and rules read at a sample.
 struct Probe {
@@ -96,8 +99,9 @@ struct Probe {
   long long steps = 0;   // steps since the start of the run
   MotionExtent motion;   // since the start of the run (when RunSpec::track_motion)
   double speed = 0.0;    // largest free-node speed [m/s]
-  // The block motions `motion` is measured from (when RunSpec::track_motion), else null.
-  const std::vector<BlockMotion>* motion_base = nullptr;
+  // Each block's motion since the start of the run, whose largest is `motion` (when
+  // RunSpec::track_motion), else null.
+  const std::vector<MotionExtent>* blocks = nullptr;
 };
 
 struct Verdict {

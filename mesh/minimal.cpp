@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "mesh/triangulate.hpp"
+
 namespace voussoir {
 
 namespace {
@@ -22,24 +24,6 @@ double turn(const Vec2& o, const Vec2& a, const Vec2& b) {
 // embrace 120), so they never take them; a fuzzed arch of radius 2000 m has thousands, and its
 // `check` took 61 s before the fast paths.
 constexpr std::size_t kFastOutline = 256;
-
-// Convex hull, counter-clockwise, without collinear points (Andrew's monotone chain).
-std::vector<Vec2> convex_hull(std::vector<Vec2> p) {
-  std::sort(p.begin(), p.end(),
-            [](const Vec2& a, const Vec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-  std::vector<Vec2> h(2 * p.size());
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    while (k >= 2 && turn(h[k - 2], h[k - 1], p[i]) <= 0.0) --k;
-    h[k++] = p[i];
-  }
-  for (std::size_t i = p.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && turn(h[k - 2], h[k - 1], p[i]) <= 0.0) --k;
-    h[k++] = p[i];
-  }
-  h.resize(k > 1 ? k - 1 : k);
-  return h;
-}
 
 // Smallest width of the convex hull (rotating calipers: it lies across the normal of a hull
 // side, and the farthest vertex from side i moves forward with i).

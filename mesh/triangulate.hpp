@@ -38,6 +38,10 @@ TriMesh mesh_band(const std::vector<std::vector<Vec2>>& columns);
 // Throws std::invalid_argument if the polygon is not simple.
 TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size);
 
+// Convex hull of a point set, counter-clockwise, without collinear points (CGAL::convex_hull_2;
+// here because CGAL is confined to mesh/triangulate_cgal.cpp).
+std::vector<Vec2> convex_hull(const std::vector<Vec2>& points);
+
 // Quality mesh of the polygon symmetric about x = 0 whose right half is bounded by
 // `right_chain` (counter-clockwise, from a point with x == 0 through points with x > 0 to
 // another point with x == 0) and by the axis between those two points; the mesh of the left

@@ -1,5 +1,6 @@
-// The only file that includes CGAL: quality constrained Delaunay meshing of a simple polygon
-// (contract in triangulate.hpp).
+// The only file that includes CGAL: quality constrained Delaunay meshing of a simple polygon,
+// and the convex hull that mesh/minimal.cpp takes the width of long outlines from (contracts
+// in triangulate.hpp).
 //
 // Kernel: exact predicates, inexact constructions. Input points are stored as given, so every
 // boundary point becomes a node bit for bit. The mesher adds Steiner points: circumcentres
@@ -13,12 +14,14 @@
 // Near input corners sharper than about 60 degrees the angle bound may not be met.
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/convex_hull_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
 #include <CGAL/Delaunay_mesh_size_criteria_2.h>
 #include <CGAL/Delaunay_mesh_vertex_base_2.h>
 #include <CGAL/Delaunay_mesher_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include <iterator>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -100,6 +103,17 @@ TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size) {
     mesh.tris.push_back({node(f->vertex(0)), node(f->vertex(1)), node(f->vertex(2))});
   }
   return mesh;
+}
+
+std::vector<Vec2> convex_hull(const std::vector<Vec2>& points) {
+  std::vector<Kernel::Point_2> in, out;
+  in.reserve(points.size());
+  for (const Vec2& p : points) in.emplace_back(p.x, p.y);
+  CGAL::convex_hull_2(in.begin(), in.end(), std::back_inserter(out));
+  std::vector<Vec2> hull;
+  hull.reserve(out.size());
+  for (const Kernel::Point_2& p : out) hull.push_back({p.x(), p.y()});
+  return hull;
 }
 
 }  // namespace voussoir

@@ -170,8 +170,9 @@ double rest_time(MovedByHand& h, Move move) {
     h.sim.ledger.kinetic = 1e-9 * (1.0 + k);  // growing at every sample
     Probe p(h.sim);
     p.time = 1e-3 * k;
-    p.motion = largest_motion(h.sim.model, h.base);
-    p.motion_base = &h.base;
+    const std::vector<MotionExtent> blocks = motions_since(h.sim.model, h.base);
+    p.motion = largest_of(blocks);
+    p.blocks = &blocks;
     p.speed = 0.1 * v_rest;
     const std::optional<Verdict> v = rule.check(p);
     if (v) {
