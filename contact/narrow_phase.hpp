@@ -164,6 +164,33 @@ inline bool overlap_negligible(const std::array<Vec2, 3>& c, const std::array<Ve
   return beyond_an_edge(cx, cy, tx, ty, t2) || beyond_an_edge(tx, ty, cx, cy, c2);
 }
 
+// A lower bound of the distance between triangles c and t [m] (counter-clockwise vertices):
+// the largest clearance of one triangle's three vertices beyond an edge line of the other (the
+// separating-axis theorem: a line with one triangle on its inner side and the other at least s
+// beyond it keeps them at least s apart). 0 when no edge line separates them (touching or
+// overlapping), or when either triangle is inverted or degenerate. Not on the hot path (the
+// contact stage calls it once for a pair found apart, contact/contact.cpp note_apart), so in
+// plain vector form.
+inline double separation_lower_bound(const std::array<Vec2, 3>& c, const std::array<Vec2, 3>& t) {
+  auto cross = [](Vec2 o, Vec2 a, Vec2 b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  };
+  if (!(cross(c[0], c[1], c[2]) > 0.0) || !(cross(t[0], t[1], t[2]) > 0.0)) return 0.0;
+  double best = 0.0;
+  for (const auto* pair : {&c, &t}) {
+    const std::array<Vec2, 3>& a = *pair;
+    const std::array<Vec2, 3>& b = pair == &c ? t : c;
+    for (int i = 0; i < 3; ++i) {
+      const Vec2 p = a[i], q = a[(i + 1) % 3];
+      // |pq| x the signed distance of b's nearest vertex from the line, positive inside a.
+      double nearest = -std::numeric_limits<double>::infinity();
+      for (const Vec2& v : b) nearest = std::max(nearest, cross(p, q, v));
+      if (nearest < 0.0) best = std::max(best, -nearest / std::hypot(q.x - p.x, q.y - p.y));
+    }
+  }
+  return best;
+}
+
 // Contact between triangles c and t (vertices counter-clockwise, current positions).
 // `penalty` = Ep x out-of-plane thickness [N/m2]. Zero everything (area included) when they
 // do not overlap, when the overlap is negligible (above), or when either triangle is inverted

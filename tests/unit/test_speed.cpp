@@ -62,6 +62,80 @@ TEST(Speed, SeparatingAxisRejectsOnlyPairsWithoutContact) {
   EXPECT_EQ(separated, kernel_zero);
 }
 
+namespace {
+
+// Distance between two points sets given as triangles, by brute force: the smallest
+// point-to-segment distance over the 18 vertex-edge couples (exact for disjoint triangles).
+double triangle_distance(const std::array<Vec2, 3>& a, const std::array<Vec2, 3>& b) {
+  auto point_segment = [](Vec2 p, Vec2 s0, Vec2 s1) {
+    const double ex = s1.x - s0.x, ey = s1.y - s0.y;
+    double u = ((p.x - s0.x) * ex + (p.y - s0.y) * ey) / (ex * ex + ey * ey);
+    u = std::min(1.0, std::max(0.0, u));
+    return std::hypot(p.x - s0.x - u * ex, p.y - s0.y - u * ey);
+  };
+  double d = 1e300;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      d = std::min(d, point_segment(a[i], b[j], b[(j + 1) % 3]));
+      d = std::min(d, point_segment(b[i], a[j], a[(j + 1) % 3]));
+    }
+  return d;
+}
+
+}  // namespace
+
+// The contact stage skips a pair while its blocks have moved less than half its separation
+// bound (contact/contact.cpp note_apart): the bound must never exceed the true distance, must
+// be 0 for overlapping pairs, and must see most of the clearance of pairs that are apart (or
+// the skip would save nothing). Then any rigid motion of the pair by less than half the bound
+// leaves the kernel at zero.
+TEST(Speed, SeparationBoundIsALowerBoundOfTheDistance) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> offset(-3.0, 3.0), angle(-0.05, 0.05), unit(-1.0, 1.0);
+  int apart = 0, seen = 0;
+  double worst_ratio = 1.0;
+  for (int k = 0; k < 20000; ++k) {
+    const auto c = random_triangle(rng, {0.0, 0.0}, 1.0);
+    const auto t = random_triangle(rng, {offset(rng), offset(rng)}, 1.0);
+    const double bound = separation_lower_bound(c, t);
+    const PairForce f = triangle_pair_force(c, t, 1e9);
+    ASSERT_GE(bound, 0.0);
+    if (f.area > 0.0) {
+      EXPECT_EQ(bound, 0.0) << "pair " << k << " overlaps";
+      continue;
+    }
+    const double distance = triangle_distance(c, t);
+    EXPECT_LE(bound, distance * (1.0 + 1e-12)) << "pair " << k;
+    if (distance > 1e-3) {
+      ++apart;
+      seen += bound > 0.0 ? 1 : 0;
+      worst_ratio = std::min(worst_ratio, bound / distance);
+    }
+    if (!(bound > 0.0)) continue;
+    // Move t rigidly by less than half the bound (a rotation about its first vertex and a
+    // shift, every point by at most 0.49 bound): still no contact.
+    const double phi = angle(rng);
+    double reach = 0.0;
+    for (const Vec2& v : t) reach = std::max(reach, std::hypot(v.x - t[0].x, v.y - t[0].y));
+    const double turn = std::min(std::abs(phi), 0.24 * bound / reach);
+    const double th = phi < 0.0 ? -turn : turn;
+    const double sx = unit(rng), sy = unit(rng), len = std::hypot(sx, sy) + 1e-300;
+    const double shift = 0.24 * bound;
+    std::array<Vec2, 3> moved;
+    for (int i = 0; i < 3; ++i) {
+      const double rx = t[i].x - t[0].x, ry = t[i].y - t[0].y;
+      moved[i] = {t[0].x + std::cos(th) * rx - std::sin(th) * ry + shift * sx / len,
+                  t[0].y + std::sin(th) * rx + std::cos(th) * ry + shift * sy / len};
+    }
+    EXPECT_EQ(triangle_pair_force(c, moved, 1e9).area, 0.0) << "pair " << k;
+  }
+  std::printf("apart %d, with a positive bound %d, smallest bound / distance %.3f\n", apart, seen,
+              worst_ratio);
+  EXPECT_GT(apart, 5000);
+  // Every disjoint pair has a separating edge line (2D separating-axis theorem).
+  EXPECT_EQ(seen, apart);
+}
+
 // Edge and vertex contacts: a triangle sharing an edge or a vertex with another (exact zero
 // overlap area) is reported separated, as the kernel reports no contact.
 TEST(Speed, SeparatingAxisOnSharedEdgeAndVertex) {
