@@ -124,6 +124,10 @@ struct CapacityConfig {
   // set to zero once the kinetic energy has fallen this fraction below its peak; in [0, 1),
   // 0 = off (docs/capacity.md "Kinetic damping")
   double kinetic_damping = 1e-3;
+  // Mass scaling of the same phases, rigid blocks (core/step.hpp equalize_rigid_inertia):
+  // "equalize" lowers the inertia of the blocks slower than the model's step allows, "none"
+  // keeps the true inertia (docs/capacity.md "Mass scaling of the slow blocks")
+  std::string mass_scaling = "equalize";
 };
 
 struct OutputConfig {

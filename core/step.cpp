@@ -98,6 +98,27 @@ std::vector<double> rigid_body_stable_steps(const Simulation& sim) {
   return steps;
 }
 
+InertiaScaling equalize_rigid_inertia(Simulation& sim) {
+  InertiaScaling out;
+  if (!sim.model.is_rigid() || !sim.ctx.contact_on || sim.contact.params().restitution < 1.0)
+    return out;
+  const std::vector<ContactFrequencyBound> bounds = sim.contact.rigid_body_bounds(sim.model);
+  double top = 0.0;
+  for (const ContactFrequencyBound& c : bounds)
+    if (std::isfinite(c.omega_squared)) top = std::max(top, c.omega_squared);
+  if (!(top > 0.0)) return out;
+  RigidBodies& r = sim.model.rigid;
+  for (std::size_t b = 0; b < bounds.size(); ++b) {
+    const double factor = bounds[b].omega_squared / top;
+    if (!(factor > 0.0) || !(factor < 1.0)) continue;  // fixed, jointless, or the fastest
+    r.mass[b] *= factor;
+    r.inertia[b] *= factor;
+    ++out.blocks;
+    out.smallest = std::min(out.smallest, factor);
+  }
+  return out;
+}
+
 void advance(Simulation& sim) {
   Model& model = sim.model;
   StepContext& ctx = sim.ctx;

@@ -83,6 +83,23 @@ double stable_time_step(const Simulation& sim);
 // spread (mass scaling of the fast ones could only gain that much).
 std::vector<double> rigid_body_stable_steps(const Simulation& sim);
 
+// Mass scaling of the quasi-static phases (capacity and sweep with capacity.mass_scaling =
+// "equalize"; docs/capacity.md "Mass scaling of the slow blocks"). Rigid blocks only: lowers
+// the mass and rotational inertia of every free block whose own highest frequency on its
+// joints (contact rigid_body_bounds) is below the model's highest, by the factor
+// omega_b^2 / omega_max^2, so that every block then reaches the model's step and none sets a
+// shorter one. The loads keep the true masses (they are the nodes' lumped masses; the scaled
+// ones are only the bodies' inertia), so every equilibrium, and the static collapse load, is
+// unchanged; the heavy blocks (piers, buttresses, courses) answer faster, and the trials need
+// less simulated time. Not with impact damping (contact.restitution < 1), whose dashpots are
+// tuned to the true masses, nor for elastic blocks. Returns how many blocks were scaled and
+// the smallest factor (1 when none).
+struct InertiaScaling {
+  int blocks = 0;
+  double smallest = 1.0;
+};
+InertiaScaling equalize_rigid_inertia(Simulation& sim);
+
 // Advances the simulation by ctx.dt. Energy ledger: strain and kinetic energy at the step
 // (core/integrate.hpp for the leapfrog K), external work and damping dissipation by the
 // trapezoid over the last position increment (exact for a linear system; core/step.cpp).

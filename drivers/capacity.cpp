@@ -36,6 +36,14 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
     s.sim.ctx.local_damping = config.capacity.local_damping;
     s.sim.ctx.local_damping_outgoing = config.capacity.local_damping_mode == "outgoing";
     s.sim.ctx.kinetic_damping = config.capacity.kinetic_damping;
+    if (config.capacity.mass_scaling == "equalize") {
+      const InertiaScaling scaled = equalize_rigid_inertia(s.sim);
+      if (!quiet && scaled.blocks > 0)
+        std::fprintf(stderr,
+                     "quasi-static inertia: %d blocks lightened (down to x%.3g) to the step of "
+                     "the fastest (capacity.mass_scaling = \"equalize\")\n",
+                     scaled.blocks, scaled.smallest);
+    }
   }
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
@@ -232,6 +240,9 @@ std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
     f.value(s.sim.ctx.local_damping_outgoing ? 1.0 : 0.0);
   }
   if (s.sim.ctx.kinetic_damping > 0.0) f.value(s.sim.ctx.kinetic_damping);
+  // The bodies' inertia (lowered by the quasi-static mass scaling).
+  f.array(s.sim.model.rigid.mass);
+  f.array(s.sim.model.rigid.inertia);
   if (c.direction != 1.0) f.value(c.direction);
   // The quasi-static trials' rest rule refuses a creep (RestRule::refuse_creep).
   if (c.quasi_static) f.value(kCreepTolerance);

@@ -238,6 +238,7 @@ int command_capacity(const Config& config, const CommonOptions& common,
     nlohmann::json j = capacity_json(results[governing], opts);
     j["direction"] = directions[governing];
     j["quasi_static"] = criteria.quasi_static;
+    j["mass_scaling"] = criteria.quasi_static ? config.capacity.mass_scaling : "none";
     if (results.size() > 1) {
       nlohmann::json each = nlohmann::json::object();
       for (std::size_t i = 0; i < results.size(); ++i)

@@ -396,6 +396,7 @@ const std::vector<KeySpec>& key_table() {
       {"capacity.local_damping", [](Reader& r, const toml::node& n, Config& c) { c.capacity.local_damping = r.number(n, {0, false, 1, true}, "local damping coefficient of the quasi-static trials"); }},
       {"capacity.local_damping_mode", [](Reader& r, const toml::node& n, Config& c) { c.capacity.local_damping_mode = r.choice(n, {"outgoing", "full"}); }},
       {"capacity.kinetic_damping", [](Reader& r, const toml::node& n, Config& c) { c.capacity.kinetic_damping = r.number(n, {0, false, 1, true}, "fraction of the peak kinetic energy"); }},
+      {"capacity.mass_scaling", [](Reader& r, const toml::node& n, Config& c) { c.capacity.mass_scaling = r.choice(n, {"equalize", "none"}); }},
       {"capacity.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.capacity.tolerance = r.number(n, {0, true, 1, true}, "relative bracket width"); }},
       // [output]
       {"output.file", [](Reader& r, const toml::node& n, Config& c) { c.output.file = r.string(n); }},

@@ -107,6 +107,10 @@ const std::map<std::string, std::string>& meanings() {
       {"capacity.kinetic_damping",
        "kinetic damping of the same phases: every velocity set to zero once the kinetic energy "
        "has fallen this fraction below its peak (0: none; `--dynamic`: off; docs/capacity.md)"},
+      {"capacity.mass_scaling",
+       "rigid blocks in the same phases: equalize lowers the mass and inertia of each block "
+       "until its own stable step is the model's (loads keep the true masses); none: true "
+       "inertia (`--dynamic`: none; docs/capacity.md)"},
       // [output]
       {"output.file", "HDF5 file of `run` / `pulse` (XDMF beside it); empty: none"},
       {"output.every", "snapshot interval"},
@@ -195,6 +199,7 @@ std::string default_of(const std::string& key) {
       {"capacity.local_damping", number(c.capacity.local_damping)},
       {"capacity.local_damping_mode", quoted(c.capacity.local_damping_mode)},
       {"capacity.kinetic_damping", number(c.capacity.kinetic_damping)},
+      {"capacity.mass_scaling", quoted(c.capacity.mass_scaling)},
       {"output.file", "none"},
       {"output.every", number(c.output.every)},
       {"output.fields", list(c.output.fields, quoted)},

@@ -94,6 +94,7 @@ tolerance = 0.01
 local_damping = 0.6
 local_damping_mode = "full"
 kinetic_damping = 0.01
+mass_scaling = "none"
 
 [output]
 file = "run.h5"
@@ -198,6 +199,7 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.capacity.local_damping, 0.6);
   EXPECT_EQ(c.capacity.local_damping_mode, "full");
   EXPECT_DOUBLE_EQ(c.capacity.kinetic_damping, 0.01);
+  EXPECT_EQ(c.capacity.mass_scaling, "none");
   EXPECT_EQ(c.output.file, "run.h5");  // output paths stay relative to the working directory
   EXPECT_DOUBLE_EQ(c.output.every, 0.02);
   EXPECT_EQ(c.output.fields, (std::vector<std::string>{"velocity", "stress"}));

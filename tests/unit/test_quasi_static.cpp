@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/rigid.hpp"
+#include "core/step.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/trial.hpp"
@@ -365,13 +366,13 @@ std::string polygons(double sign) {
          block({{-2.0, -0.3}, {2.0, -0.3}, {2.0, 0.0}, {-2.0, 0.0}});
 }
 
-Config polygon_deck(const fs::path& dir, double sign) {
+Config polygon_deck(const fs::path& dir, double sign, const std::vector<std::string>& sets = {}) {
   const fs::path file = dir / (sign > 0 ? "stack.txt" : "stack_mirror.txt");
   std::ofstream(file) << polygons(sign);
   const std::string text = "[model]\nkind = \"polygons\"\nfile = \"" + file.string() +
                            "\"\nfixed = [3]\n[material]\nmodel = \"rigid\"\n"
                            "[contact]\nfriction = 0.8\n";
-  return parse_deck(text, (dir / "stack.toml").string());
+  return parse_deck(text, (dir / "stack.toml").string(), sets);
 }
 
 TEST(Direction, MinusXIsPlusXOfTheMirroredStructure) {
@@ -430,6 +431,56 @@ TEST(Direction, BothReportsEachDirectionAndTheSmaller) {
   fs::remove_all(dir);
 }
 
+// Mass scaling of the quasi-static phases (core/step.hpp equalize_rigid_inertia) on the stack
+// of three unequal blocks: each block's own stable step reaches the model's, which does not
+// change; the loads keep the true masses; impact damping and elastic blocks are left alone;
+// and lambda* is the same bracket as with the true inertia, towards both directions.
+TEST(MassScaling, EveryBlockReachesTheStepAndTheCapacityStays) {
+  const fs::path dir = fs::temp_directory_path() / "voussoir_mass_scaling";
+  fs::create_directories(dir);
+  const Config deck = polygon_deck(dir, 1.0);
+  Simulation sim = make_simulation(deck);
+  const std::vector<double> before = rigid_body_stable_steps(sim);
+  const double dt_before = stable_time_step(sim);
+  const std::vector<double> node_mass = sim.model.nodes.mass;
+  const std::vector<double> mass = sim.model.rigid.mass;
+  const InertiaScaling scaled = equalize_rigid_inertia(sim);
+  EXPECT_GE(scaled.blocks, 2);  // the three blocks differ: two are slower than the fastest
+  EXPECT_LT(scaled.smallest, 0.9);
+  const std::vector<double> after = rigid_body_stable_steps(sim);
+  ASSERT_EQ(after.size(), before.size());
+  for (std::size_t b = 0; b < after.size(); ++b) {
+    if (!std::isfinite(before[b])) continue;
+    EXPECT_NEAR(after[b], dt_before, 1e-9 * dt_before) << "block " << b;
+    EXPECT_LE(sim.model.rigid.mass[b], mass[b]) << "block " << b;
+  }
+  EXPECT_NEAR(stable_time_step(sim), dt_before, 1e-9 * dt_before);
+  EXPECT_EQ(sim.model.nodes.mass, node_mass);  // the loads' masses
+
+  Simulation damped = make_simulation(polygon_deck(dir, 1.0, {"contact.restitution=0.5"}));
+  EXPECT_EQ(equalize_rigid_inertia(damped).blocks, 0);
+  Simulation elastic = make_simulation(polygon_deck(dir, 1.0, {"material.model=elastic"}));
+  EXPECT_EQ(equalize_rigid_inertia(elastic).blocks, 0);
+
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  for (double direction : {1.0, -1.0}) {
+    crit.direction = direction;
+    const CapacityResult equalized = find_capacity(deck, crit, 2, true);
+    const CapacityResult inertial =
+        find_capacity(polygon_deck(dir, 1.0, {"capacity.mass_scaling=none"}), crit, 2, true);
+    ASSERT_TRUE(equalized.bracketed && inertial.bracketed) << direction;
+    EXPECT_EQ(equalized.lo, inertial.lo) << direction;
+    EXPECT_EQ(equalized.hi, inertial.hi) << direction;
+    long long steps_equalized = 0, steps_inertial = 0;
+    for (const TrialResult& t : equalized.trials) steps_equalized += t.steps;
+    for (const TrialResult& t : inertial.trials) steps_inertial += t.steps;
+    std::printf("direction %+g: lambda* %.5f, steps %lld with mass scaling, %lld without\n",
+                direction, equalized.lambda_star, steps_equalized, steps_inertial);
+  }
+  fs::remove_all(dir);
+}
+
 TEST(QuasiStaticInput, BadDampingAndDirectionAreRefused) {
   for (const std::string key : {"capacity.local_damping", "capacity.kinetic_damping"}) {
     for (const char* v : {"1.0", "-0.1", "2"}) {
@@ -443,6 +494,15 @@ TEST(QuasiStaticInput, BadDampingAndDirectionAreRefused) {
         EXPECT_NE(msg.find("[0, 1)"), std::string::npos) << msg;
       }
     }
+  }
+  try {
+    parse_deck(block_deck("rigid"), "test", {"capacity.mass_scaling=fast"});
+    FAIL() << "capacity.mass_scaling = fast";
+  } catch (const DeckError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("capacity.mass_scaling"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("fast"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("equalize"), std::string::npos) << msg;
   }
   const fs::path dir = fs::temp_directory_path() / "voussoir_direction_bad";
   fs::create_directories(dir);
