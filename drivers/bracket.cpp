@@ -3,6 +3,7 @@
 #include "drivers/bracket.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace voussoir {
 
@@ -21,6 +22,37 @@ bool narrow_bracket(Bracket& b, const std::vector<double>& probes,
   for (std::size_t i = 0; i < probes.size(); ++i)
     if (!crossed[i] && probes[i] < b.hi) b.lo = std::max(b.lo, probes[i]);
   return b.lo != before.lo || b.hi != before.hi;
+}
+
+std::vector<double> probes_ahead(const Bracket& b, const std::vector<double>& probes,
+                                 const std::vector<Outcome3>& known, double tolerance, int points,
+                                 ProbePlacement placement, int depth, double estimate) {
+  std::vector<double> ahead;
+  Bracket cur = b;
+  std::vector<double> round = probes;
+  std::vector<Outcome3> outcomes = known;
+  for (int d = 0; d < depth; ++d) {
+    const double middle = std::isnan(estimate) ? 0.5 * (cur.lo + cur.hi) : estimate;
+    std::vector<bool> crossed(round.size());
+    for (std::size_t i = 0; i < round.size(); ++i) {
+      if (outcomes[i] != Outcome3::Unknown) {
+        crossed[i] = outcomes[i] == Outcome3::Crossed;
+        continue;
+      }
+      bool below_crossed = false, above_uncrossed = false;
+      for (std::size_t j = 0; j < round.size(); ++j) {
+        below_crossed |= outcomes[j] == Outcome3::Crossed && round[j] < round[i];
+        above_uncrossed |= outcomes[j] == Outcome3::NotCrossed && round[j] > round[i];
+      }
+      crossed[i] = below_crossed || (!above_uncrossed && round[i] > middle);
+    }
+    if (!round.empty() && !narrow_bracket(cur, round, crossed)) break;
+    if (!(cur.hi - cur.lo > tolerance * cur.hi)) break;  // shrink_bracket stops here
+    round = bracket_probes(cur, points, placement);
+    outcomes.assign(round.size(), Outcome3::Unknown);
+    ahead.insert(ahead.end(), round.rbegin(), round.rend());
+  }
+  return ahead;
 }
 
 }  // namespace voussoir

@@ -18,6 +18,7 @@
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/trial.hpp"
+#include "drivers/trial_pool.hpp"
 #include "io/hdf5_output.hpp"
 #include "limit/limit_analysis.hpp"
 
@@ -160,10 +161,14 @@ RunSpec trial_spec(const SettledState& settled, double lambda, const TrialCriter
 }  // namespace
 
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& crit,
-                      bool quiet) {
+                      bool quiet, const std::atomic<bool>* cancel) {
   const auto t0 = Clock::now();
   Simulation sim = settled.sim;  // deep copy
   RunSpec spec = trial_spec(settled, lambda, crit, quiet);
+  if (cancel)
+    spec.on_sample = [cancel](const Simulation&, const Probe&) {
+      return !cancel->load(std::memory_order_relaxed);
+    };
   const Outcome o = run_engine(sim, spec);
 
   TrialResult r;
@@ -349,43 +354,47 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   res.joints_settled = joint_resultants(settled.sim.model, settled.sim.contact, settled.sim.ctx.dt);
   Journal journal(search.journal, settled_fingerprint(settled, crit));
 
-  // Runs the lambdas not in the journal (in parallel when cores allow); returns all results
-  // in input order.
-  auto evaluate = [&](const std::vector<double>& lambdas) {
-    std::vector<TrialResult> out(lambdas.size());
-    std::vector<int> todo;
-    for (size_t i = 0; i < lambdas.size(); ++i) {
-      if (const nlohmann::json* j = find_trial(journal, lambdas[i])) {
-        out[i] = trial_from_json(*j);
-        ++res.resumed_trials;
-      } else {
-        todo.push_back(static_cast<int>(i));
+  // Trials on a pool of workers (drivers/trial_pool.hpp): a round's trials side by side, and
+  // idle workers running ahead the trials the search will most likely ask for next. One
+  // worker inside an active parallel region (the cells of a sweep).
+  const int workers = omp_in_parallel() ? 1 : std::max(1, omp_get_max_threads());
+  TrialPool pool(
+      workers,
+      [&](double lambda, const std::atomic<bool>& cancel) {
+        return run_trial(settled, lambda, crit, quiet, &cancel);
+      },
+      [&](const TrialResult& r) { journal.append(trial_json(r)); });
+  // Rounds ahead that the planners list (bracket.hpp probes_ahead), and their guess of
+  // lambda* (the middle of each bracket until limit analysis gives kAheadGuess x lambda_la).
+  const int depth = 1 + (workers + points - 1) / points;
+  double guess = std::numeric_limits<double>::quiet_NaN();
+  // Runs a round (trials of the journal taken from it); returns all results in input order.
+  std::vector<double> from_journal;
+  auto evaluate = [&](const std::vector<double>& lambdas,
+                      TrialPool::Planner planner = TrialPool::nothing_ahead) {
+    for (double l : lambdas)
+      if (const nlohmann::json* j = find_trial(journal, l)) {
+        pool.preload(trial_from_json(*j));
+        from_journal.push_back(l);
       }
-    }
-    const int n = static_cast<int>(todo.size());
-    // A failed trial (RunError from the engine's guards) may not leave the parallel region:
-    // kept, and the first one in input order thrown after it.
-    std::vector<std::exception_ptr> failed(lambdas.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, std::min(n, omp_get_max_threads())))
-    for (int k = 0; k < n; ++k) {
-      const int i = todo[k];
-      try {
-        out[i] = run_trial(settled, lambdas[i], crit, quiet);
-      } catch (...) {
-        failed[i] = std::current_exception();
-        continue;
-      }
-#pragma omp critical(voussoir_journal)
-      journal.append(trial_json(out[i]));
-    }
-    for (const std::exception_ptr& e : failed)
-      if (e) std::rethrow_exception(e);
-    for (size_t i = 0; i < out.size(); ++i) {
-      const bool resumed = std::find(todo.begin(), todo.end(), int(i)) == todo.end();
-      report(out[i], quiet, resumed);
-      res.trials.push_back(out[i]);
+    const std::vector<TrialResult> out = pool.run_round(lambdas, std::move(planner));
+    for (const TrialResult& r : out) {
+      const bool resumed =
+          std::find(from_journal.begin(), from_journal.end(), r.lambda) != from_journal.end();
+      if (resumed) ++res.resumed_trials;
+      report(r, quiet, resumed);
+      res.trials.push_back(r);
     }
     return out;
+  };
+  auto keep_pool_stats = [&] {
+    pool.cancel_ahead();
+    const PoolStats st = pool.stats();
+    res.workers = st.workers;
+    res.ahead = st.ahead;
+    res.ahead_used = st.ahead_used;
+    res.ahead_cancelled = st.cancelled;
+    res.ahead_unused_s = st.unused_s;
   };
 
   double lo = config.capacity.lambda_min, hi = config.capacity.lambda_max;
@@ -410,7 +419,15 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       if (!quiet)
         std::fprintf(stderr, "limit analysis: lambda_la = %.5f, seeded bracket [%.5f, %.5f]\n",
                      la.lambda_la, s_lo, s_hi);
-      const auto round = evaluate({s_lo, s_hi});
+      // Ahead: the widening when the seed is contradicted, else the k-section of the seed.
+      const double tol = res.tolerance;
+      guess = kAheadGuess * la.lambda_la;
+      const auto round = evaluate({s_lo, s_hi}, [=](const std::vector<Outcome3>& known) {
+        if (known[0] == Outcome3::Crossed) return std::vector<double>{s_lo * 0.7};
+        if (known[1] == Outcome3::NotCrossed) return std::vector<double>{s_hi * 1.3};
+        return probes_ahead(Bracket{s_lo, s_hi}, {}, {}, tol, points, ProbePlacement::KSection,
+                            depth, guess);
+      });
       if (!round[0].collapsed) lo = s_lo;
       if (round[1].collapsed) {
         hi = s_hi;
@@ -487,6 +504,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   };
   res.bracketed = have_hi;
   if (!have_hi) {
+    keep_pool_stats();
     keep_joints(lo, hi, false);
     res.lo = res.hi = res.lambda_star = lo;
     res.wall_s = seconds_since(t0);
@@ -498,8 +516,15 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   shrink_bracket(
       bracket, res.tolerance, points, ProbePlacement::KSection,
       [&](const std::vector<double>& lambdas) {
+        const Bracket now = bracket;
+        const double tol = res.tolerance;
         std::vector<bool> collapsed;
-        for (const TrialResult& r : evaluate(lambdas)) collapsed.push_back(r.collapsed);
+        for (const TrialResult& r :
+             evaluate(lambdas, [=](const std::vector<Outcome3>& known) {
+               return probes_ahead(now, lambdas, known, tol, points, ProbePlacement::KSection,
+                                   depth, guess);
+             }))
+          collapsed.push_back(r.collapsed);
         return collapsed;
       },
       [&](const Bracket& b) {
@@ -507,6 +532,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       });
   lo = bracket.lo;
   hi = bracket.hi;
+  keep_pool_stats();
   for (const TrialResult& r : res.trials) {
     if (!r.collapsed || r.lambda != hi) continue;
     res.hinges = r.hinges;

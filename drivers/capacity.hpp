@@ -39,6 +39,7 @@
 // points is fixed, not taken from the thread count, so results do not depend on it. Stops when
 // hi - lo <= tolerance x hi; lambda* = (lo + hi) / 2.
 
+#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
@@ -129,8 +130,9 @@ std::string settled_fingerprint(const SettledState& settled, const TrialCriteria
 
 // One trial from a copy of the settled state; unless quiet, a progress line on stderr every
 // kProgressPeriod of wall time.
+// A set `cancel` stops the trial at its next sample (its result is then meaningless).
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria,
-                      bool quiet);
+                      bool quiet, const std::atomic<bool>* cancel = nullptr);
 
 // The movie of a trial (`capacity --movie`, docs/thrust.md): the trial run again from the
 // settled state (bit for bit the trial that was classified: same state, load and rules) with
@@ -172,6 +174,11 @@ struct CapacitySearch {
   std::string movie;
 };
 
+// Where the trials run ahead on idle cores guess lambda* when limit analysis seeds the search
+// (drivers/trial_pool.hpp; it decides only what runs ahead, never a result): lambda* / lambda_la
+// lies between 0.981 (the churches) and 1.000 (the blocks) on the 22 regression cases
+// (docs/regression.md), 0.992 on the semicircular arch.
+inline constexpr double kAheadGuess = 0.99;
 inline constexpr double kSeedLow = 0.92;   // FDEM lambda* lies a few % below the rigid LA one
 inline constexpr double kSeedHigh = 1.02;  // (deformable blocks, non-associative friction)
 
@@ -208,6 +215,10 @@ struct CapacityResult {
   bool has_stable = false, has_collapsed = false;
   bool has_movie = false;              // CapacitySearch::movie was recorded
   MovieReport movie;
+  // Trials run ahead on idle cores (drivers/trial_pool.hpp); depends on timing, not on results.
+  int workers = 1;
+  int ahead = 0, ahead_used = 0, ahead_cancelled = 0;
+  double ahead_unused_s = 0.0;
 };
 
 // Bisection for lambda*; progress lines on stderr unless quiet.

@@ -74,6 +74,8 @@ void print_capacity(const CapacityResult& res, const CapacityOptions& opts) {
                 static_cast<int>(res.trials.size()), res.seed.unseeded_trials);
   if (res.resumed_trials > 0)
     std::printf("%d trials taken from the journal %s\n", res.resumed_trials, opts.resume.c_str());
+  if (res.ahead > 0)
+    std::printf("%d trials run ahead on idle cores, %d of them used\n", res.ahead, res.ahead_used);
   if (res.bracketed) std::printf("failure mode: %s\n", failure_mode_text(res).c_str());
   for (const Hinge& h : res.hinges) {
     std::printf("  %-7s joint %d (blocks %d-%d)", h.kind.c_str(), h.joint, h.block_a, h.block_b);
@@ -112,6 +114,13 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
           {"points_per_round", opts.points},
           {"hinges", hinges_to_json(res.hinges)},
           {"resumed_trials", res.resumed_trials},
+          // Trials run ahead on idle cores (drivers/trial_pool.hpp): timing, like wall_s.
+          {"ahead",
+           {{"workers", res.workers},
+            {"started", res.ahead},
+            {"used", res.ahead_used},
+            {"cancelled", res.ahead_cancelled},
+            {"unused_wall_s", res.ahead_unused_s}}},
           {"seed",
            {{"used", res.seed.used},
             {"limit_status", res.seed.status},

@@ -41,5 +41,69 @@ TEST(Bracket, ProbesAndNonMonotoneRounds) {
   EXPECT_EQ(n.hi, 1.5);
 }
 
+// Ahead of a round's outcomes: once they are known, the first probes ahead are exactly the next
+// round's (as a set, highest first); while one is pending it is guessed by the middle of the
+// bracket, or by a known outcome it cannot contradict in a monotone response.
+TEST(Bracket, ProbesAheadFollowTheSearch) {
+  const double threshold = 0.37, tol = 0.005;
+  Bracket b{0.0, 1.0};
+  std::vector<double> probes = bracket_probes(b, 2, ProbePlacement::KSection);
+  int rounds = 0;
+  while (b.hi - b.lo > tol * b.hi) {
+    std::vector<bool> crossed;
+    std::vector<Outcome3> known;
+    for (double p : probes) {
+      crossed.push_back(p > threshold);
+      known.push_back(p > threshold ? Outcome3::Crossed : Outcome3::NotCrossed);
+    }
+    const std::vector<double> ahead =
+        probes_ahead(b, probes, known, tol, 2, ProbePlacement::KSection, 2);
+    Bracket next = b;
+    narrow_bracket(next, probes, crossed);
+    if (!(next.hi - next.lo > tol * next.hi)) {
+      EXPECT_TRUE(ahead.empty());  // the search stops: nothing to run ahead
+    } else {
+      const std::vector<double> want = bracket_probes(next, 2, ProbePlacement::KSection);
+      ASSERT_GE(ahead.size(), 2u);
+      EXPECT_EQ(ahead[0], want[1]);
+      EXPECT_EQ(ahead[1], want[0]);
+    }
+    b = next;
+    probes = bracket_probes(b, 2, ProbePlacement::KSection);
+    ++rounds;
+  }
+  EXPECT_GT(rounds, 3);
+
+  // Pending outcomes on [0, 3] with probes 1 and 2.
+  const Bracket c{0.0, 3.0};
+  const std::vector<double> p12{1.0, 2.0};
+  using O = Outcome3;
+  auto first_round = [&](std::vector<O> known) {
+    return probes_ahead(c, p12, known, 1e-3, 2, ProbePlacement::KSection, 1);
+  };
+  auto highest_first = [](const Bracket& x) {
+    std::vector<double> p = bracket_probes(x, 2, ProbePlacement::KSection);
+    return std::vector<double>{p[1], p[0]};
+  };
+  // Nothing known: 1 below the middle stands, 2 above it collapses -> [1, 2].
+  EXPECT_EQ(first_round({O::Unknown, O::Unknown}), highest_first({1.0, 2.0}));
+  // 1 collapsed: 2 is ignored -> [0, 1].
+  EXPECT_EQ(first_round({O::Crossed, O::Unknown}), highest_first({0.0, 1.0}));
+  // 2 stood: 1 stands too -> [2, 3].
+  EXPECT_EQ(first_round({O::Unknown, O::NotCrossed}), highest_first({2.0, 3.0}));
+  // A guess of the threshold below both probes: both collapse -> [0, 1].
+  EXPECT_EQ(probes_ahead(c, p12, {O::Unknown, O::Unknown}, 1e-3, 2, ProbePlacement::KSection, 1,
+                         0.5),
+            highest_first({0.0, 1.0}));
+  // Two rounds ahead: the second guessed the same way inside [1, 2].
+  const std::vector<double> two =
+      probes_ahead(c, p12, {O::Unknown, O::Unknown}, 1e-3, 2, ProbePlacement::KSection, 2);
+  ASSERT_EQ(two.size(), 4u);
+  const std::vector<double> in12 = bracket_probes({1.0, 2.0}, 2, ProbePlacement::KSection);
+  const std::vector<double> second = highest_first({in12[0], in12[1]});
+  EXPECT_EQ(two[2], second[0]);
+  EXPECT_EQ(two[3], second[1]);
+}
+
 }  // namespace
 }  // namespace voussoir

@@ -1,0 +1,117 @@
+#pragma once
+// Capacity trials on a pool of workers, with the idle ones running ahead (drivers/capacity.cpp).
+//
+// The k-section of `capacity` runs its rounds one after the other, the `points` trials of a
+// round side by side. A round lasts as long as its longest trial, and near lambda* that is a
+// collapsing trial that starts slowly (critical slowing down: church B's last round holds a
+// stable trial of 25 s of wall and a collapse of 50 s), so a core waits idle for half the
+// round. The pool gives such a core the trial the search is most likely to ask for next: the
+// search hands each round a planner (drivers/bracket.hpp probes_ahead: the next rounds' probes
+// with the round's pending outcomes guessed), and a worker with nothing of the round left to
+// start takes the first planned lambda that is neither run nor running. When the search asks
+// for a lambda that was run ahead, it takes the result (or waits for the running trial); a
+// trial run ahead that has dropped out of every plan (a wrong guess) is cancelled at its next
+// sample.
+//
+// What the search sees does not change: each trial's result is a function of its lambda alone
+// (every trial starts from a copy of the same settled state), and the search reads only the
+// results of the lambdas it asks for, in its own order, so lambda*, the bracket, the trials
+// reported and their order are those of the search without the pool, bit for bit, whatever
+// the number of workers and whatever ran ahead. Only wall times, and the count of trials run
+// ahead (PoolStats), depend on timing.
+//
+// Workers are threads of their own, each running its trials with one OpenMP thread (results do
+// not depend on the thread count); with one worker (one thread, or inside the parallel cells
+// of a sweep) there is no thread and no running ahead: the trials run in the caller, in order,
+// as before the pool.
+
+#include <atomic>
+#include <condition_variable>
+#include <exception>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "drivers/bracket.hpp"
+#include "drivers/capacity.hpp"
+
+namespace voussoir {
+
+struct PoolStats {
+  int workers = 1;
+  int ahead = 0;          // trials started before the search asked for them
+  int ahead_used = 0;     // of which the search then asked for
+  int cancelled = 0;      // trials run ahead and cancelled (dropped out of every plan)
+  double unused_s = 0.0;  // [s] of worker wall time on trials the search never asked for
+};
+
+class TrialPool {
+ public:
+  // Runs one trial; stops early (any result, discarded) once `cancel` is set.
+  using Runner = std::function<TrialResult(double lambda, const std::atomic<bool>& cancel)>;
+  // The lambdas to run ahead, best first, from what is known of the round's outcomes.
+  using Planner = std::function<std::vector<double>(const std::vector<Outcome3>& known)>;
+  // Called (serialised) once for every trial the search asks for and that ran here, as soon
+  // as it has both finished and been asked for: the journal, which so holds only the search's
+  // trials, as without the pool.
+  using Finished = std::function<void(const TrialResult&)>;
+
+  TrialPool(int workers, Runner run, Finished finished);
+  ~TrialPool();
+  TrialPool(const TrialPool&) = delete;
+  TrialPool& operator=(const TrialPool&) = delete;
+
+  // A result known beforehand (from the journal): the search's lookups and the planner see it.
+  void preload(const TrialResult& result);
+  // The results of `lambdas`, in their order (run here, taken from a trial run ahead, or from
+  // preload); while they run, idle workers run `planner`'s lambdas ahead. The first failed
+  // trial, in input order, is rethrown once all have ended.
+  std::vector<TrialResult> run_round(const std::vector<double>& lambdas, Planner planner);
+  // A planner with nothing ahead.
+  static std::vector<double> nothing_ahead(const std::vector<Outcome3>&) { return {}; }
+
+  // Cancels every trial running ahead and waits for them to stop (the search is over).
+  void cancel_ahead();
+
+  PoolStats stats() const;
+
+ private:
+  enum class State { Running, Done, Failed };
+  struct Entry {
+    State state = State::Running;
+    TrialResult result;
+    std::exception_ptr error;
+    bool asked = false;     // the search asked for it
+    bool ahead = false;     // started before it was asked for
+    bool recorded = false;  // passed to Finished (or preloaded)
+    std::shared_ptr<std::atomic<bool>> cancel = std::make_shared<std::atomic<bool>>(false);
+  };
+
+  void work();
+  // Under the lock: the next lambda to start, or false.
+  bool pick(double& lambda);
+  // Under the lock: the plan from the round's outcomes; cancels what dropped out of it.
+  void replan();
+  // Under the lock: passes a finished trial the search asked for to Finished, once; a failure
+  // of Finished fails the trial.
+  void record(Entry& e);
+
+  Runner run_;
+  Finished finished_;
+  int workers_ = 1;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::map<double, Entry> entries_;
+  std::vector<double> round_;
+  Planner planner_ = nothing_ahead;
+  std::vector<double> plan_;
+  int running_ = 0;
+  bool stop_ = false;
+  PoolStats stats_;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace voussoir

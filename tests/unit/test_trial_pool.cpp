@@ -1,0 +1,125 @@
+// The pool of capacity trials (drivers/trial_pool.hpp): the search's results whatever ran
+// ahead, a wrong guess cancelled, and a search whose trials and bracket do not depend on the
+// number of workers.
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <atomic>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "drivers/capacity.hpp"
+#include "drivers/trial_pool.hpp"
+#include "io/deck.hpp"
+
+namespace voussoir {
+namespace {
+
+TrialResult fake(double lambda, double threshold) {
+  TrialResult r;
+  r.lambda = lambda;
+  r.collapsed = lambda > threshold;
+  r.steps = static_cast<long long>(1000 * lambda);
+  return r;
+}
+
+// Three workers, a round of two: the idle third runs the planned lambda 5 ahead; the round's
+// trial at 1 does not end before 5 has started, so the plan is certainly taken up. Once the
+// round is known the planner drops 5, which is cancelled (its runner waits for that), and
+// the journal sees only the round's trials.
+TEST(TrialPool, RunsAheadAndCancelsAWrongGuess) {
+  std::atomic<bool> ahead_started{false};
+  std::vector<double> journal;
+  {
+    TrialPool pool(
+        3,
+        [&](double lambda, const std::atomic<bool>& cancel) {
+          if (lambda == 5.0) {
+            ahead_started = true;
+            while (!cancel.load()) std::this_thread::yield();
+          }
+          if (lambda == 1.0)
+            while (!ahead_started.load()) std::this_thread::yield();
+          return fake(lambda, 1.5);
+        },
+        [&](const TrialResult& r) { journal.push_back(r.lambda); });
+    const std::vector<TrialResult> out =
+        pool.run_round({1.0, 2.0}, [](const std::vector<Outcome3>& known) {
+          const bool pending = known[0] == Outcome3::Unknown || known[1] == Outcome3::Unknown;
+          return pending ? std::vector<double>{5.0} : std::vector<double>{};
+        });
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_EQ(out[0].lambda, 1.0);
+    EXPECT_FALSE(out[0].collapsed);
+    EXPECT_EQ(out[1].lambda, 2.0);
+    EXPECT_TRUE(out[1].collapsed);
+    pool.cancel_ahead();
+    const PoolStats st = pool.stats();
+    EXPECT_EQ(st.workers, 3);
+    EXPECT_EQ(st.ahead, 1);
+    EXPECT_EQ(st.ahead_used, 0);
+    EXPECT_EQ(st.cancelled, 1);
+  }
+  ASSERT_EQ(journal.size(), 2u);
+  EXPECT_EQ(journal[0] + journal[1], 3.0);
+}
+
+// Trials planned ahead give the search their results when it asks; a failing trial is
+// rethrown when the search asks for it, not while it only ran ahead.
+TEST(TrialPool, TakesTrialsRunAheadAndRethrowsOnlyAskedFailures) {
+  TrialPool pool(
+      2,
+      [&](double lambda, const std::atomic<bool>&) {
+        if (lambda == 9.0) throw std::runtime_error("trial 9 failed");
+        return fake(lambda, 3.5);
+      },
+      [](const TrialResult&) {});
+  // The planner keeps 3 and 9 ahead for as long as this round is the pool's.
+  auto plan = [](const std::vector<Outcome3>&) { return std::vector<double>{3.0, 9.0}; };
+  EXPECT_EQ(pool.run_round({1.0}, plan).front().lambda, 1.0);
+  const std::vector<TrialResult> next = pool.run_round({3.0}, TrialPool::nothing_ahead);
+  EXPECT_FALSE(next.front().collapsed);
+  EXPECT_THROW(pool.run_round({9.0}, TrialPool::nothing_ahead), std::runtime_error);
+  pool.cancel_ahead();
+}
+
+Config block_deck() {
+  return parse_deck(R"(
+[model]
+kind = "block"
+width = 0.5
+height = 1.0
+[contact]
+friction = 0.3
+)",
+                    "block.toml");
+}
+
+// The same trials, verdicts, steps and bracket with one worker (no running ahead) and with
+// three (two rounds ahead), whatever ran ahead.
+TEST(TrialPool, CapacityDoesNotDependOnTheWorkers) {
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const CapacityResult one = find_capacity(block_deck(), TrialCriteria{}, 2, true);
+  omp_set_num_threads(3);
+  const CapacityResult three = find_capacity(block_deck(), TrialCriteria{}, 2, true);
+  omp_set_num_threads(threads);
+  EXPECT_EQ(one.workers, 1);
+  EXPECT_EQ(one.ahead, 0);
+  EXPECT_EQ(three.workers, 3);
+  EXPECT_EQ(one.lambda_star, three.lambda_star);
+  EXPECT_EQ(one.lo, three.lo);
+  EXPECT_EQ(one.hi, three.hi);
+  ASSERT_EQ(one.trials.size(), three.trials.size());
+  for (std::size_t i = 0; i < one.trials.size(); ++i) {
+    EXPECT_EQ(one.trials[i].lambda, three.trials[i].lambda);
+    EXPECT_EQ(one.trials[i].collapsed, three.trials[i].collapsed);
+    EXPECT_EQ(one.trials[i].steps, three.trials[i].steps);
+    EXPECT_EQ(one.trials[i].max_displacement, three.trials[i].max_displacement);
+  }
+}
+
+}  // namespace
+}  // namespace voussoir
