@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/fnv.hpp"
+#include "core/rigid.hpp"
 #include "drivers/bracket.hpp"
 #include "drivers/journal.hpp"
 #include "drivers/motion.hpp"
@@ -46,6 +47,11 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
                      scaled.blocks, scaled.smallest);
     }
   }
+  // Rigid blocks without impact damping take the quasi-static step (core/rigid.hpp
+  // kQuasiStaticRigidStepFraction), unless the deck gives its own dt.
+  const bool longer_step = crit.quasi_static && s.sim.model.is_rigid() &&
+                           !(config.solver.dt > 0.0) && !(s.sim.contact.params().restitution < 1.0);
+  if (longer_step) s.sim.ctx.dt *= kQuasiStaticRigidStepFraction / kRigidStepFraction;
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
   Simulation& sim = s.sim;
@@ -81,9 +87,11 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
   s.steps = sim.step;
   s.wall_s = seconds_since(t0);
   if (!quiet)
-    std::fprintf(stderr, "settled under gravity: %s after %.3f s (%lld steps, %.2f s wall)\n",
+    std::fprintf(stderr,
+                 "settled under gravity: %s after %.3f s (%lld steps of %.4g s, %.2f s wall; "
+                 "energy balance error %.2g)\n",
                  s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"),
-                 s.settle_time, s.steps, s.wall_s);
+                 s.settle_time, s.steps, sim.ctx.dt, s.wall_s, sim.ledger.balance_error());
   return s;
 }
 
