@@ -376,15 +376,20 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   // lambda* (the middle of each bracket until limit analysis gives kAheadGuess x lambda_la).
   const int depth = 1 + (workers + points - 1) / points;
   double guess = std::numeric_limits<double>::quiet_NaN();
-  // Runs a round (trials of the journal taken from it); returns all results in input order.
+  // The journal's trials, known to the pool before anything runs (none is run ahead again).
   std::vector<double> from_journal;
+  for (const nlohmann::json& j : journal.records())
+    if (j.contains("lambda") && find_trial(journal, j.at("lambda").get<double>()) == &j) {
+      try {
+        pool.preload(trial_from_json(j));
+      } catch (const std::exception&) {
+        continue;  // a record without a trial's fields: that trial runs again
+      }
+      from_journal.push_back(j.at("lambda").get<double>());
+    }
+  // Runs a round (trials of the journal taken from it); returns all results in input order.
   auto evaluate = [&](const std::vector<double>& lambdas,
                       TrialPool::Planner planner = TrialPool::nothing_ahead) {
-    for (double l : lambdas)
-      if (const nlohmann::json* j = find_trial(journal, l)) {
-        pool.preload(trial_from_json(*j));
-        from_journal.push_back(l);
-      }
     const std::vector<TrialResult> out = pool.run_round(lambdas, std::move(planner));
     for (const TrialResult& r : out) {
       const bool resumed =

@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <atomic>
+#include <cstdio>
 #include <string>
 #include <thread>
 #include <vector>
@@ -119,6 +120,24 @@ TEST(TrialPool, CapacityDoesNotDependOnTheWorkers) {
     EXPECT_EQ(one.trials[i].steps, three.trials[i].steps);
     EXPECT_EQ(one.trials[i].max_displacement, three.trials[i].max_displacement);
   }
+}
+
+// A search resumed from its whole journal takes every trial from it: none is run ahead and
+// asked for again.
+TEST(TrialPool, AWholeJournalRunsNoTrialAgain) {
+  const std::string journal = ::testing::TempDir() + "trial_pool_resume.journal";
+  std::remove(journal.c_str());
+  CapacitySearch search;
+  search.quiet = true;
+  search.journal = journal;
+  const CapacityResult full = find_capacity(block_deck(), TrialCriteria{}, search);
+  const CapacityResult resumed = find_capacity(block_deck(), TrialCriteria{}, search);
+  EXPECT_EQ(resumed.resumed_trials, static_cast<int>(full.trials.size()));
+  EXPECT_EQ(resumed.ahead_used, 0);
+  EXPECT_EQ(resumed.lambda_star, full.lambda_star);
+  ASSERT_EQ(resumed.trials.size(), full.trials.size());
+  for (std::size_t i = 0; i < full.trials.size(); ++i)
+    EXPECT_EQ(resumed.trials[i].steps, full.trials[i].steps);
 }
 
 }  // namespace
