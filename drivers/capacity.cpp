@@ -9,6 +9,7 @@
 #include <exception>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "core/fnv.hpp"
@@ -302,13 +303,6 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   return r;
 }
 
-// A finished trial of the journal with this lambda (written with 17 significant digits, so a
-// resumed search that recomputes the same lambdas finds them bit for bit), or null.
-const nlohmann::json* find_trial(const Journal& journal, double lambda) {
-  for (const nlohmann::json& j : journal.records())
-    if (j.contains("lambda") && j.at("lambda").get<double>() == lambda) return &j;
-  return nullptr;
-}
 
 }  // namespace
 
@@ -377,23 +371,24 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   const int depth = 1 + (workers + points - 1) / points;
   double guess = std::numeric_limits<double>::quiet_NaN();
   // The journal's trials, known to the pool before anything runs (none is run ahead again).
-  std::vector<double> from_journal;
-  for (const nlohmann::json& j : journal.records())
-    if (j.contains("lambda") && find_trial(journal, j.at("lambda").get<double>()) == &j) {
-      try {
-        pool.preload(trial_from_json(j));
-      } catch (const std::exception&) {
-        continue;  // a record without a trial's fields: that trial runs again
-      }
-      from_journal.push_back(j.at("lambda").get<double>());
+  // Lambdas are written with 17 significant digits, so a resumed search that recomputes the
+  // same lambdas finds them bit for bit; the first record of a lambda counts (preload).
+  std::set<double> from_journal;
+  for (const nlohmann::json& j : journal.records()) {
+    if (!j.contains("lambda")) continue;
+    try {
+      pool.preload(trial_from_json(j));
+    } catch (const std::exception&) {
+      continue;  // a record without a trial's fields: that trial runs again
     }
+    from_journal.insert(j.at("lambda").get<double>());
+  }
   // Runs a round (trials of the journal taken from it); returns all results in input order.
   auto evaluate = [&](const std::vector<double>& lambdas,
                       TrialPool::Planner planner = TrialPool::nothing_ahead) {
     const std::vector<TrialResult> out = pool.run_round(lambdas, std::move(planner));
     for (const TrialResult& r : out) {
-      const bool resumed =
-          std::find(from_journal.begin(), from_journal.end(), r.lambda) != from_journal.end();
+      const bool resumed = from_journal.count(r.lambda) != 0;
       if (resumed) ++res.resumed_trials;
       report(r, quiet, resumed);
       res.trials.push_back(r);
@@ -436,8 +431,8 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       const double tol = res.tolerance;
       guess = kAheadGuess * la.lambda_la;
       const auto round = evaluate({s_lo, s_hi}, [=](const std::vector<Outcome3>& known) {
-        if (known[0] == Outcome3::Crossed) return std::vector<double>{s_lo * 0.7};
-        if (known[1] == Outcome3::NotCrossed) return std::vector<double>{s_hi * 1.3};
+        if (known[0] == Outcome3::Crossed) return std::vector<double>{s_lo * kWidenDown};
+        if (known[1] == Outcome3::NotCrossed) return std::vector<double>{s_hi * kWidenUp};
         return probes_ahead(Bracket{s_lo, s_hi}, {}, {}, tol, points, ProbePlacement::KSection,
                             depth, guess);
       });
@@ -458,7 +453,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
         bool found = false;
         while (!found && down > 1e-3) {
           ++res.seed.widenings;
-          down *= 0.7;
+          down *= kWidenDown;
           if (!quiet)
             std::fprintf(stderr, "seed contradicted (collapse at %.5f): widening down\n", hi);
           const auto r = evaluate({down});
@@ -476,7 +471,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
         double up = s_hi;
         while (!have_hi && up < kCap) {
           ++res.seed.widenings;
-          up *= 1.3;
+          up *= kWidenUp;
           const auto r = evaluate({up});
           if (r[0].collapsed) {
             hi = up;

@@ -28,8 +28,9 @@
 // elastic blocks alike; with rigid blocks the settle (whose state every trial starts from)
 // also lowers the slow blocks' inertia to the model's step when capacity.mass_scaling is
 // "equalize" (core/step.hpp equalize_rigid_inertia; the loads keep the true masses), and
-// takes the quasi-static step of rigid blocks (core/rigid.hpp kQuasiStaticRigidStepFraction). On a rigid sliding mechanism the damping does not arrest the slide,
-// it slows it to a steady creep below the rest speed;
+// takes the quasi-static step of rigid blocks (core/rigid.hpp kQuasiStaticRigidStepFraction).
+// On a rigid sliding mechanism the damping does not arrest the slide, it slows it to a steady
+// creep below the rest speed;
 // before the creep check the rest rule took that creep for rest and lambda* of the sliding
 // semicircular arch at beta = 120 came out 11% above the limit analysis that bounds it, so
 // rigid blocks ran the physical trials until the check came in. TrialCriteria::direction
@@ -184,6 +185,10 @@ struct CapacitySearch {
 inline constexpr double kAheadGuess = 0.99;
 inline constexpr double kSeedLow = 0.92;   // FDEM lambda* lies a few % below the rigid LA one
 inline constexpr double kSeedHigh = 1.02;  // (deformable blocks, non-associative friction)
+// A contradicted seed widens geometrically by these factors per trial (down when its low end
+// collapsed, up when its high end stood).
+inline constexpr double kWidenDown = 0.7;
+inline constexpr double kWidenUp = 1.3;
 
 struct SeedReport {
   bool used = false;
