@@ -408,6 +408,10 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   double lo = config.capacity.lambda_min, hi = config.capacity.lambda_max;
   bool have_hi = false;
   constexpr double kFirstGuess = 0.125, kCap = 8.0;
+  // The seed's ends are presumed, not run: [s_lo, s_hi] is where the k-section starts, and an
+  // end is run only when the search ends on it (below).
+  double s_lo = 0.0, s_hi = 0.0;
+  bool lo_presumed = false, hi_presumed = false;
 
   if (hi > lo) {
     // The deck's bracket: its upper end is checked (the lower is trusted, 0 by default).
@@ -422,65 +426,17 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     res.seed.status = la.status;
     if (la.status == "optimal" && la.lambda_la > lo) {
       res.seed.used = true;
+      res.seed.held = true;  // until a presumed end that is run contradicts it
       res.seed.lambda_la = la.lambda_la;
-      double s_lo = std::max(lo, kSeedLow * la.lambda_la), s_hi = kSeedHigh * la.lambda_la;
+      s_lo = std::max(lo, kSeedLow * la.lambda_la);
+      s_hi = kSeedHigh * la.lambda_la;
       if (!quiet)
         std::fprintf(stderr, "limit analysis: lambda_la = %.5f, seeded bracket [%.5f, %.5f]\n",
                      la.lambda_la, s_lo, s_hi);
-      // Ahead: the widening when the seed is contradicted, else the k-section of the seed.
-      const double tol = res.tolerance;
+      lo = s_lo;
+      hi = s_hi;
+      have_hi = lo_presumed = hi_presumed = true;
       guess = kAheadGuess * la.lambda_la;
-      const auto round = evaluate({s_lo, s_hi}, [=](const std::vector<Outcome3>& known) {
-        if (known[0] == Outcome3::Crossed) return std::vector<double>{s_lo * kWidenDown};
-        if (known[1] == Outcome3::NotCrossed) return std::vector<double>{s_hi * kWidenUp};
-        return probes_ahead(Bracket{s_lo, s_hi}, {}, {}, tol, points, ProbePlacement::KSection,
-                            depth, guess);
-      });
-      if (!round[0].collapsed) lo = s_lo;
-      if (round[1].collapsed) {
-        hi = s_hi;
-        have_hi = true;
-      } else {
-        lo = s_hi;
-      }
-      res.seed.held = !round[0].collapsed && round[1].collapsed;
-      // Widen a contradicted seed geometrically: down when its low end collapsed, up when its
-      // high end stood.
-      if (round[0].collapsed) {
-        hi = s_lo;
-        have_hi = true;
-        double down = s_lo;
-        bool found = false;
-        while (!found && down > 1e-3) {
-          ++res.seed.widenings;
-          down *= kWidenDown;
-          if (!quiet)
-            std::fprintf(stderr, "seed contradicted (collapse at %.5f): widening down\n", hi);
-          const auto r = evaluate({down});
-          if (r[0].collapsed) hi = down;
-          else {
-            lo = down;
-            found = true;
-          }
-        }
-        if (!found) lo = 0.0;
-      }
-      if (!have_hi) {
-        if (!quiet)
-          std::fprintf(stderr, "seed contradicted (stable at %.5f): widening up\n", s_hi);
-        double up = s_hi;
-        while (!have_hi && up < kCap) {
-          ++res.seed.widenings;
-          up *= kWidenUp;
-          const auto r = evaluate({up});
-          if (r[0].collapsed) {
-            hi = up;
-            have_hi = true;
-          } else {
-            lo = up;
-          }
-        }
-      }
     }
   }
 
@@ -500,6 +456,92 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       lo = std::max(lo, r.lambda);
     }
   }
+
+  // A contradicted seed widens geometrically: down from a low end that collapsed (it becomes
+  // hi), up from a high end that stood (it becomes lo; no collapse up to kCap leaves the
+  // search unbracketed).
+  auto widen_down = [&](double from) {
+    hi = from;
+    double down = from;
+    while (down > 1e-3) {
+      ++res.seed.widenings;
+      down *= kWidenDown;
+      if (!quiet) std::fprintf(stderr, "seed contradicted (collapse at %.5f): widening down\n", hi);
+      if (!evaluate({down})[0].collapsed) {
+        lo = down;
+        return;
+      }
+      hi = down;
+    }
+    lo = 0.0;
+  };
+  auto widen_up = [&](double from) {
+    if (!quiet) std::fprintf(stderr, "seed contradicted (stable at %.5f): widening up\n", from);
+    lo = from;
+    have_hi = false;
+    double up = from;
+    while (!have_hi && up < kCap) {
+      ++res.seed.widenings;
+      up *= kWidenUp;
+      if (evaluate({up})[0].collapsed) {
+        hi = up;
+        have_hi = true;
+      } else {
+        lo = up;
+      }
+    }
+  };
+
+  // k-section (drivers/bracket.hpp): `points` interior lambdas per round, run in parallel. A
+  // presumed seed end that is still an end of the bracket is also listed for idle workers,
+  // after the rounds ahead.
+  Bracket bracket{lo, hi};
+  while (have_hi) {
+    shrink_bracket(
+        bracket, res.tolerance, points, ProbePlacement::KSection,
+        [&](const std::vector<double>& lambdas) {
+          const Bracket now = bracket;
+          const double tol = res.tolerance;
+          const bool check_lo = lo_presumed && now.lo == s_lo;
+          const bool check_hi = hi_presumed && now.hi == s_hi;
+          std::vector<bool> collapsed;
+          for (const TrialResult& r : evaluate(lambdas, [=](const std::vector<Outcome3>& known) {
+                 std::vector<double> ahead = probes_ahead(now, lambdas, known, tol, points,
+                                                          ProbePlacement::KSection, depth, guess);
+                 if (check_hi) ahead.push_back(s_hi);
+                 if (check_lo) ahead.push_back(s_lo);
+                 return ahead;
+               }))
+            collapsed.push_back(r.collapsed);
+          return collapsed;
+        },
+        [&](const Bracket& b) {
+          if (!quiet) std::fprintf(stderr, "bracket [%.5f, %.5f]\n", b.lo, b.hi);
+        });
+    lo = bracket.lo;
+    hi = bracket.hi;
+    // The seed's ends that the search ended on are run now (both in one round when it ended on
+    // both: no probe fell between them). The bracket holds when they do as presumed.
+    std::vector<double> ends;
+    if (lo_presumed && lo == s_lo) ends.push_back(s_lo);
+    if (hi_presumed && hi == s_hi) ends.push_back(s_hi);
+    lo_presumed = hi_presumed = false;
+    if (ends.empty()) break;
+    res.seed.ends_run += static_cast<int>(ends.size());
+    bool lo_collapsed = false, hi_stood = false;
+    for (const TrialResult& r : evaluate(ends)) {
+      if (r.lambda == s_lo && r.collapsed) lo_collapsed = true;
+      if (r.lambda == s_hi && !r.collapsed) hi_stood = true;
+    }
+    if (!lo_collapsed && !hi_stood) break;
+    res.seed.held = false;
+    if (lo_collapsed)
+      widen_down(s_lo);
+    else
+      widen_up(s_hi);
+    bracket = Bracket{lo, hi};
+  }
+
   // The joint resultants of the trials at the bracket's ends (CapacityResult).
   auto keep_joints = [&](double at_lo, double at_hi, bool bracketed) {
     if (at_lo == 0.0) res.joints_stable = res.joints_settled, res.has_stable = true;
@@ -518,28 +560,6 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     res.wall_s = seconds_since(t0);
     return res;
   }
-
-  // k-section (drivers/bracket.hpp): `points` interior lambdas per round, run in parallel.
-  Bracket bracket{lo, hi};
-  shrink_bracket(
-      bracket, res.tolerance, points, ProbePlacement::KSection,
-      [&](const std::vector<double>& lambdas) {
-        const Bracket now = bracket;
-        const double tol = res.tolerance;
-        std::vector<bool> collapsed;
-        for (const TrialResult& r :
-             evaluate(lambdas, [=](const std::vector<Outcome3>& known) {
-               return probes_ahead(now, lambdas, known, tol, points, ProbePlacement::KSection,
-                                   depth, guess);
-             }))
-          collapsed.push_back(r.collapsed);
-        return collapsed;
-      },
-      [&](const Bracket& b) {
-        if (!quiet) std::fprintf(stderr, "bracket [%.5f, %.5f]\n", b.lo, b.hi);
-      });
-  lo = bracket.lo;
-  hi = bracket.hi;
   keep_pool_stats();
   for (const TrialResult& r : res.trials) {
     if (!r.collapsed || r.lambda != hi) continue;

@@ -163,9 +163,10 @@ MovieReport record_trial(const SettledState& settled, double lambda, const Trial
 struct CapacitySearch {
   int points = 2;                      // trial lambdas per round
   // Seed the bracket from rigid-block limit analysis (limit/limit_analysis.hpp) on the same
-  // blocks: [kSeedLow, kSeedHigh] x lambda_la, both ends confirmed by FDEM trials, widened
-  // geometrically when a trial contradicts the seed. Ignored when the deck gives
-  // capacity.lambda_max.
+  // blocks: the k-section starts on [kSeedLow, kSeedHigh] x lambda_la with both ends presumed
+  // (stable at the low end, collapsed at the high one), and an end is run only when the search
+  // ends on it; one that contradicts the seed widens the bracket geometrically. Ignored when
+  // the deck gives capacity.lambda_max.
   bool seed_from_limit = true;
   // Journal of finished trials (JSON lines); trials found there are not run again, so a killed
   // capacity run resumes where it stopped. Empty = none.
@@ -194,7 +195,8 @@ struct SeedReport {
   bool used = false;
   double lambda_la = 0.0;
   std::string status;                  // limit analysis status
-  bool held = false;                   // both seeded ends confirmed by the first trials
+  bool held = false;                   // no seeded end run contradicted the seed
+  int ends_run = 0;                    // seeded ends run (0 when lambda* lies inside)
   int widenings = 0;                   // rounds spent widening a contradicted bracket
   int unseeded_trials = 0;             // trials the unseeded search would run to this bracket
 };

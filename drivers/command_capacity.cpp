@@ -127,6 +127,7 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
             {"lambda_la",
              res.seed.used ? nlohmann::json(res.seed.lambda_la) : nlohmann::json(nullptr)},
             {"held", res.seed.held},
+            {"ends_run", res.seed.ends_run},
             {"widenings", res.seed.widenings},
             {"unseeded_trials_estimate", res.seed.unseeded_trials},
             {"trials_saved", res.seed.used ? res.seed.unseeded_trials -

@@ -121,6 +121,33 @@ TEST(Capacity, ResumesFromItsJournal) {
   EXPECT_THROW(find_capacity(block_deck(0.8), TrialCriteria{}, search), RunError);
 }
 
+// The limit-analysis seed's ends are presumed, not run, while lambda* lies between them: every
+// trial of the default search lies strictly inside [0.92, 1.02] lambda_la. A tolerance that the
+// seeded bracket already meets ends the search on both ends: they are then the only trials,
+// and they confirm the seed.
+TEST(Capacity, SeedEndsAreRunOnlyWhenTheSearchEndsOnThem) {
+  const CapacityResult r = find_capacity(block_deck(0.8), TrialCriteria{}, 2, true);
+  ASSERT_TRUE(r.seed.used);
+  const double s_lo = kSeedLow * r.seed.lambda_la, s_hi = kSeedHigh * r.seed.lambda_la;
+  EXPECT_EQ(r.seed.ends_run, 0);
+  EXPECT_TRUE(r.seed.held);
+  for (const TrialResult& t : r.trials) {
+    EXPECT_GT(t.lambda, s_lo);
+    EXPECT_LT(t.lambda, s_hi);
+  }
+
+  Config wide = block_deck(0.8);
+  wide.capacity.tolerance = 0.5;
+  const CapacityResult w = find_capacity(wide, TrialCriteria{}, 2, true);
+  EXPECT_EQ(w.seed.ends_run, 2);
+  EXPECT_TRUE(w.seed.held);
+  ASSERT_EQ(w.trials.size(), 2u);
+  EXPECT_EQ(w.lo, s_lo);
+  EXPECT_EQ(w.hi, s_hi);
+  EXPECT_FALSE(w.trials[0].collapsed);
+  EXPECT_TRUE(w.trials[1].collapsed);
+}
+
 // The unseeded search replayed with an oracle: geometric growth 0.125, 0.25 | 0.5, 1 brackets
 // 0.3 in [0.25, 0.5] after 4 trials, then each round of 2 shrinks the bracket by 3.
 TEST(Capacity, UnseededTrialCountReplaysTheSearch) {
