@@ -528,6 +528,10 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     lo_presumed = hi_presumed = false;
     if (ends.empty()) break;
     res.seed.ends_run += static_cast<int>(ends.size());
+    if (!quiet)
+      for (double l : ends)
+        std::fprintf(stderr, "the bracket ends on the seed's presumed %s end: running %.5f\n",
+                     l == s_lo ? "low" : "high", l);
     bool lo_collapsed = false, hi_stood = false;
     for (const TrialResult& r : evaluate(ends)) {
       if (r.lambda == s_lo && r.collapsed) lo_collapsed = true;

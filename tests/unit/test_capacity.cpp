@@ -148,6 +148,52 @@ TEST(Capacity, SeedEndsAreRunOnlyWhenTheSearchEndsOnThem) {
   EXPECT_TRUE(w.trials[1].collapsed);
 }
 
+// Soft joints (kn = 1e6 N/m3) let the block's toe sink under the load, and it overturns at
+// lambda* of about 0.044, far below its rigid-block limit analysis (0.5): every probe inside the
+// presumed seed collapses, the search ends on the seed's low end, runs it, finds it collapsed,
+// and widens down until a trial stands. The final bracket is then made of trials that ran, as
+// always. (Springs this soft set a step of 0.07 s: the 22 trials take milliseconds.)
+TEST(Capacity, AContradictedSeedWidensFromItsPresumedEnd) {
+  const Config soft = parse_deck(R"(
+[model]
+kind = "block"
+width = 0.5
+height = 1.0
+[material]
+model = "rigid"
+density = 2000.0
+young = 40e9
+poisson = 0.2
+[contact]
+friction = 0.8
+normal_stiffness = 1e6
+)",
+                                 "soft_block.toml");
+  TrialCriteria crit;
+  crit.quasi_static = true;  // as `capacity` runs it (its physical settle rocks off the toe)
+  const CapacityResult r = find_capacity(soft, crit, 2, true);
+  ASSERT_TRUE(r.bracketed);
+  ASSERT_TRUE(r.seed.used);
+  EXPECT_FALSE(r.seed.held);
+  EXPECT_EQ(r.seed.ends_run, 1);
+  EXPECT_GT(r.seed.widenings, 0);
+  EXPECT_LT(r.hi, kSeedLow * r.seed.lambda_la);
+  EXPECT_LE(r.hi - r.lo, r.tolerance * r.hi);
+  bool lo_ran = false, hi_ran = false;
+  for (const TrialResult& t : r.trials) {
+    if (t.lambda <= r.lo) {
+      EXPECT_FALSE(t.collapsed) << t.lambda;
+    }
+    if (t.lambda >= r.hi) {
+      EXPECT_TRUE(t.collapsed) << t.lambda;
+    }
+    lo_ran = lo_ran || t.lambda == r.lo;
+    hi_ran = hi_ran || t.lambda == r.hi;
+  }
+  EXPECT_TRUE(lo_ran);
+  EXPECT_TRUE(hi_ran);
+}
+
 // The unseeded search replayed with an oracle: geometric growth 0.125, 0.25 | 0.5, 1 brackets
 // 0.3 in [0.25, 0.5] after 4 trials, then each round of 2 shrinks the bracket by 3.
 TEST(Capacity, UnseededTrialCountReplaysTheSearch) {
