@@ -352,6 +352,9 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   const SettledState settled = settle(config, crit, quiet);
   res.triangles = settled.sim.model.tris.size();
   res.dt = settled.sim.ctx.dt;
+  res.settle_time = settled.settle_time;
+  res.settle_steps = settled.steps;
+  res.settle_wall_s = settled.wall_s;
   if (!settled.settled) throw RunError(unsettled_message(settled, crit));
   res.joints_settled = joint_resultants(settled.sim.model, settled.sim.contact, settled.sim.ctx.dt);
   Journal journal(search.journal, settled_fingerprint(settled, crit));

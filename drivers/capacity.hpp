@@ -210,6 +210,11 @@ struct CapacityResult {
   double wall_s = 0.0;
   Index triangles = 0;
   double dt = 0.0;                     // [s]
+  // The settle under gravity that every trial starts from: simulated time [s], steps, wall
+  // time [s] (run once, before any trial: on one core).
+  double settle_time = 0.0;
+  long long settle_steps = 0;
+  double settle_wall_s = 0.0;
   bool bracketed = false;              // false when no collapse was found up to the cap
   SeedReport seed;
   int resumed_trials = 0;              // trials taken from the journal

@@ -131,6 +131,9 @@ TEST(Capacity, SeedEndsAreRunOnlyWhenTheSearchEndsOnThem) {
   const double s_lo = kSeedLow * r.seed.lambda_la, s_hi = kSeedHigh * r.seed.lambda_la;
   EXPECT_EQ(r.seed.ends_run, 0);
   EXPECT_TRUE(r.seed.held);
+  // The settle every trial starts from is reported: its steps at the search's step.
+  EXPECT_GT(r.settle_steps, 0);
+  EXPECT_NEAR(r.settle_time, static_cast<double>(r.settle_steps) * r.dt, r.dt);
   for (const TrialResult& t : r.trials) {
     EXPECT_GT(t.lambda, s_lo);
     EXPECT_LT(t.lambda, s_hi);
