@@ -9,6 +9,7 @@
 #include <exception>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <nlohmann/json.hpp>
 
@@ -349,7 +350,9 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   const int points = std::max(1, search.points);
   CapacityResult res;
   res.tolerance = config.capacity.tolerance;
-  const SettledState settled = settle(config, crit, quiet);
+  std::optional<SettledState> own;
+  if (!search.settled) own = settle(config, crit, quiet);
+  const SettledState& settled = search.settled ? *search.settled : *own;
   res.triangles = settled.sim.model.tris.size();
   res.dt = settled.sim.ctx.dt;
   res.settle_time = settled.settle_time;

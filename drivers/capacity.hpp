@@ -43,6 +43,7 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -175,6 +176,10 @@ struct CapacitySearch {
   // When set and a collapse is bracketed: the collapsed trial at the upper bound recorded by
   // record_trial to this HDF5 file (CapacityResult::movie).
   std::string movie;
+  // A settle to start from instead of settling here: settle() of the same deck and criteria.
+  // The settle under gravity does not read the load direction, so the two searches of
+  // `--direction both` share one (the same trials, bit for bit, as each settling alone).
+  std::shared_ptr<const SettledState> settled;
 };
 
 // Where the trials run ahead on idle cores guess lambda* when limit analysis seeds the search

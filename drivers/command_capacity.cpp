@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 #include <nlohmann/json.hpp>
@@ -209,13 +210,15 @@ int command_capacity(const Config& config, const CommonOptions& common,
   search.seed_from_limit = !opts.no_seed;
   search.journal = opts.resume;
 
-  // One search per direction asked (`--direction both`: +x then -x, each with its own
-  // settle, seed and journal; the smaller lambda* governs).
+  // One search per direction asked (`--direction both`: +x then -x, each with its own seed
+  // and journal, from one settle under gravity; the smaller lambda* governs).
   std::vector<std::string> directions;
   if (opts.direction == "both")
     directions = {"+x", "-x"};
   else
     directions = {opts.direction};
+  if (directions.size() > 1)
+    search.settled = std::make_shared<const SettledState>(settle(config, criteria, common.quiet));
   std::vector<CapacityResult> results;
   for (const std::string& d : directions) {
     TrialCriteria c = criteria;

@@ -6,12 +6,14 @@
 
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "drivers/capacity.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
+#include "same_search.hpp"
 
 namespace voussoir {
 namespace {
@@ -195,6 +197,30 @@ normal_stiffness = 1e6
   }
   EXPECT_TRUE(lo_ran);
   EXPECT_TRUE(hi_ran);
+}
+
+// The settle under gravity does not read the load direction, so `--direction both` settles
+// once and both searches start from it: towards -x, the search from a settle shared with +x is
+// the search that settles alone, trial for trial and bit for bit.
+TEST(Capacity, ASharedSettleGivesTheSameSearch) {
+  const Config deck = block_deck(0.8);
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  CapacitySearch shared;
+  shared.quiet = true;
+  SettledState once = settle(deck, crit, true);
+  once.wall_s = -1.0;  // a mark: a search that starts from this settle reports it
+  shared.settled = std::make_shared<const SettledState>(std::move(once));
+  crit.direction = -1.0;
+  CapacitySearch alone;
+  alone.quiet = true;
+  const CapacityResult a = find_capacity(deck, crit, alone);
+  const CapacityResult b = find_capacity(deck, crit, shared);
+  ASSERT_TRUE(a.bracketed && b.bracketed);
+  EXPECT_EQ(b.settle_wall_s, -1.0);
+  EXPECT_GE(a.settle_wall_s, 0.0);
+  EXPECT_EQ(a.settle_steps, b.settle_steps);
+  expect_same_search(a, b);
 }
 
 // The unseeded search replayed with an oracle: geometric growth 0.125, 0.25 | 0.5, 1 brackets

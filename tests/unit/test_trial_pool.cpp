@@ -14,6 +14,7 @@
 #include "drivers/capacity.hpp"
 #include "drivers/trial_pool.hpp"
 #include "io/deck.hpp"
+#include "same_search.hpp"
 
 namespace voussoir {
 namespace {
@@ -110,16 +111,7 @@ TEST(TrialPool, CapacityDoesNotDependOnTheWorkers) {
   EXPECT_EQ(one.workers, 1);
   EXPECT_EQ(one.ahead, 0);
   EXPECT_EQ(three.workers, 3);
-  EXPECT_EQ(one.lambda_star, three.lambda_star);
-  EXPECT_EQ(one.lo, three.lo);
-  EXPECT_EQ(one.hi, three.hi);
-  ASSERT_EQ(one.trials.size(), three.trials.size());
-  for (std::size_t i = 0; i < one.trials.size(); ++i) {
-    EXPECT_EQ(one.trials[i].lambda, three.trials[i].lambda);
-    EXPECT_EQ(one.trials[i].collapsed, three.trials[i].collapsed);
-    EXPECT_EQ(one.trials[i].steps, three.trials[i].steps);
-    EXPECT_EQ(one.trials[i].max_displacement, three.trials[i].max_displacement);
-  }
+  expect_same_search(one, three);
 }
 
 // A search resumed from its whole journal takes every trial from it: none is run ahead and
