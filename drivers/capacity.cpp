@@ -304,7 +304,6 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   return r;
 }
 
-
 }  // namespace
 
 int unseeded_trial_count(double lambda_star, double lambda_min, double tolerance, int points) {
@@ -400,15 +399,6 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       res.trials.push_back(r);
     }
     return out;
-  };
-  auto keep_pool_stats = [&] {
-    pool.cancel_ahead();
-    const PoolStats st = pool.stats();
-    res.workers = st.workers;
-    res.ahead = st.ahead;
-    res.ahead_used = st.ahead_used;
-    res.ahead_cancelled = st.cancelled;
-    res.ahead_unused_s = st.unused_s;
   };
 
   double lo = config.capacity.lambda_min, hi = config.capacity.lambda_max;
@@ -562,15 +552,21 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
         res.joints_collapsed = r.joints, res.has_collapsed = true;
     }
   };
+  // The search is over: what still runs ahead is cancelled, and the pool's figures kept.
+  pool.cancel_ahead();
+  const PoolStats st = pool.stats();
+  res.workers = st.workers;
+  res.ahead = st.ahead;
+  res.ahead_used = st.ahead_used;
+  res.ahead_cancelled = st.cancelled;
+  res.ahead_unused_s = st.unused_s;
   res.bracketed = have_hi;
   if (!have_hi) {
-    keep_pool_stats();
     keep_joints(lo, hi, false);
     res.lo = res.hi = res.lambda_star = lo;
     res.wall_s = seconds_since(t0);
     return res;
   }
-  keep_pool_stats();
   for (const TrialResult& r : res.trials) {
     if (!r.collapsed || r.lambda != hi) continue;
     res.hinges = r.hinges;

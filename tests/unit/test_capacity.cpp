@@ -87,11 +87,8 @@ TEST(Capacity, CollapseUnderGravityEndsTheSettleEarly) {
 // not run again and the result is the same bit for bit. The kill is imitated by cutting the
 // journal after three trials and half of the fourth line.
 TEST(Capacity, ResumesFromItsJournal) {
-  const std::string journal = ::testing::TempDir() + "capacity_resume.journal";
-  std::remove(journal.c_str());
-  CapacitySearch search;
-  search.quiet = true;
-  search.journal = journal;
+  const CapacitySearch search = journalled_search("capacity_resume.journal");
+  const std::string& journal = search.journal;
   const Config config = block_deck(0.3);
   const CapacityResult full = find_capacity(config, TrialCriteria{}, search);
   ASSERT_GE(full.trials.size(), 5u);

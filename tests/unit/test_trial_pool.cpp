@@ -117,11 +117,7 @@ TEST(TrialPool, CapacityDoesNotDependOnTheWorkers) {
 // A search resumed from its whole journal takes every trial from it: none is run ahead and
 // asked for again.
 TEST(TrialPool, AWholeJournalRunsNoTrialAgain) {
-  const std::string journal = ::testing::TempDir() + "trial_pool_resume.journal";
-  std::remove(journal.c_str());
-  CapacitySearch search;
-  search.quiet = true;
-  search.journal = journal;
+  const CapacitySearch search = journalled_search("trial_pool_resume.journal");
   const CapacityResult full = find_capacity(block_deck(), TrialCriteria{}, search);
   const CapacityResult resumed = find_capacity(block_deck(), TrialCriteria{}, search);
   EXPECT_EQ(resumed.resumed_trials, static_cast<int>(full.trials.size()));
