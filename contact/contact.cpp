@@ -203,6 +203,11 @@ struct ContactSystem::Impl {
   std::vector<Index> pb_c, pb_t;
   std::vector<double> apart_below;
   std::vector<std::uint8_t> remeasure;
+  // Per pair, 1 when it touched at the last step: it goes to the kernel without the pre-tests
+  // (evaluate). Not state: a pair flagged 0 only takes the longer way to the same result, so a
+  // restart, which begins with every flag at 0, continues bit for bit
+  // (Restart.*BitForBit, Rigid.RestartContinuesBitForBit).
+  std::vector<std::uint8_t> touched;
   double clearance_floor = 0.0;  // smallest separation worth skipping on [m]
   bool skin = false;             // on for kSkinPairs candidate pairs and more
 
@@ -333,6 +338,7 @@ void ContactSystem::Impl::index_pairs(const Model& model) {
   skin = np >= kSkinPairs;
   apart_below.assign(np, -std::numeric_limits<double>::infinity());
   remeasure.assign(np, 0);
+  touched.assign(np, 0);
   const Triangles& t = model.tris;
   const double scale = kTangentialStiffnessRatio * penalty * thickness;
   const bool mapped = joints || params.shear_stiffness > 0.0 || damping;
@@ -653,6 +659,10 @@ inline double max3(double a, double b, double c) {
 // 24 are separated, 19 are corner touches and 12 overlap.
 template <bool kFriction, bool kSkin>
 inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double dt, PairResult& r) {
+  // A pair that touched at the last step most likely still does: straight to the kernel. The
+  // pre-tests below only skip pairs whose kernel certainly gives nothing, so this changes no
+  // result (the kernel then gives nothing itself, and the pair is flagged again below).
+  if (touched[p]) return evaluate_overlap<kFriction>(p, n, dt, r);
   // Still certainly apart since it was last found so (note_apart): its friction history and
   // damping state were cleared then and nothing has set them since.
   double moved = 0.0;
@@ -702,6 +712,7 @@ template <bool kFriction>
   const std::array<Vec2, 3> tv{Vec2{x[pt0[p]], y[pt0[p]]}, Vec2{x[pt1[p]], y[pt1[p]]},
                                Vec2{x[pt2[p]], y[pt2[p]]}};
   const PairForce f = triangle_pair_force(cv, tv, joints ? ep_thick[p] : penalty * thickness);
+  touched[p] = f.area > 0.0;
   if (!(f.area > 0.0)) {
     if constexpr (kFriction) sx[p] = sy[p] = 0.0;
     if (damping) std::fill_n(prev_f.data() + kDampedValues * p, kDampedValues, 0.0);
