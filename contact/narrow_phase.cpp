@@ -10,12 +10,10 @@ namespace {
 // A triangle clipped by 3 lines has at most 6 vertices; 8 leaves room.
 constexpr int kMaxPoly = 8;
 
-// Convex polygon, counter-clockwise. on_c[k] = 1 when the edge from vertex k to k+1 lies on an
-// edge of c (made by clipping), 0 when it lies on an edge of t.
+// Convex polygon, counter-clockwise.
 struct Poly {
   int n = 0;
   double x[kMaxPoly], y[kMaxPoly];
-  unsigned char on_c[kMaxPoly];
 };
 
 // Affine function a + b x + c y.
@@ -55,8 +53,7 @@ inline Bary barycentric(const Edges& t) {
   return b;
 }
 
-// Keeps the part of convex `in` where f >= 0 (Sutherland-Hodgman, one line of c), keeping
-// track of which triangle each edge lies on.
+// Keeps the part of convex `in` where f >= 0 (Sutherland-Hodgman, one line).
 // kN: the vertex count when known at compile time (3: the first clip of t), else 0.
 template <int kN = 0>
 inline void clip(const Poly& __restrict in, const Affine& f, Poly& __restrict out) {
@@ -70,17 +67,11 @@ inline void clip(const Poly& __restrict in, const Affine& f, Poly& __restrict ou
       const double s = fp / (fp - fq);
       out.x[m] = in.x[p] + s * (in.x[q] - in.x[p]);
       out.y[m] = in.y[p] + s * (in.y[q] - in.y[p]);
-      // Leaving: the next edge runs along the clip line; entering: along the edge p -> q.
-      out.on_c[m] = fq < 0.0 ? 1 : in.on_c[p];
       ++m;
     }
     if (fq >= 0.0) {
       out.x[m] = in.x[q];
       out.y[m] = in.y[q];
-      // Its outgoing edge is part of the input edge q -> r, unless q lies on the line and r
-      // is outside: then no intersection follows and the edge runs along the clip line.
-      const int r = q + 1 < n ? q + 1 : 0;
-      out.on_c[m] = (fq == 0.0 && fv[r] < 0.0) ? 1 : in.on_c[q];
       ++m;
     }
   }
@@ -112,6 +103,42 @@ inline Moments moments(const Poly& p) {
   return m;
 }
 
+// Moments of the part of convex P where fv >= 0 (fv: a function's values at P's vertices,
+// affine along the edges), as clip then moments would give them, without forming the
+// polygon: its vertices are summed into the fan as the clip emits them.
+inline Moments clipped_moments(const Poly& P, const double* fv) {
+  Moments m;
+  double x0 = 0.0, y0 = 0.0, px = 0.0, py = 0.0, a2 = 0.0, sx6 = 0.0, sy6 = 0.0;
+  int count = 0;
+  auto emit = [&](double x, double y) {
+    if (count == 0) {
+      x0 = x, y0 = y;
+    } else if (count >= 2) {
+      const double ux = px - x0, uy = py - y0, vx = x - x0, vy = y - y0;
+      const double cr = ux * vy - uy * vx;
+      a2 += cr;
+      sx6 += (ux + vx) * cr;
+      sy6 += (uy + vy) * cr;
+    }
+    px = x, py = y;
+    ++count;
+  };
+  const int n = P.n;
+  for (int q = 0, p = n - 1; q < n; p = q++) {
+    const double fp = fv[p], fq = fv[q];
+    if ((fp < 0.0 && fq > 0.0) || (fp > 0.0 && fq < 0.0)) {
+      const double s = fp / (fp - fq);
+      emit(P.x[p] + s * (P.x[q] - P.x[p]), P.y[p] + s * (P.y[q] - P.y[p]));
+    }
+    if (fq >= 0.0) emit(P.x[q], P.y[q]);
+  }
+  if (count < 3) return m;
+  m.area = 0.5 * a2;
+  m.sx = m.area * x0 + sx6 * (1.0 / 6.0);
+  m.sy = m.area * y0 + sy6 * (1.0 / 6.0);
+  return m;
+}
+
 // What one triangle's potential field does over the overlap: G = int_P grad phi (x) (1, x, y)
 // dA (row 0: x component of grad phi, row 1: y) and Phi = int_P phi dA.
 struct Field {
@@ -119,160 +146,92 @@ struct Field {
   double phi = 0.0;
 };
 
-// Along a segment (parameter s in [0, 1]) phi = 3 min_m (alpha_m + beta_m s), the lower
-// envelope of three lines (concave, at most three pieces). Returns the exact integrals
-// i0 = int_0^1 phi ds and i1 = int_0^1 phi s ds (then int phi x ds = ax i0 + dx i1).
-inline void integrate_phi(const double* alpha, const double* beta, double& i0, double& i1) {
-  double j0 = 0.0, j1 = 0.0;
-  auto piece = [&](int m, double s0, double s1) {
-    const double w = s1 - s0;
-    const double p0 = alpha[m] + beta[m] * s0, p1 = alpha[m] + beta[m] * s1;
-    // int_s0^s1 phi ds and int_s0^s1 phi s ds for linear phi (p0, p1 at the ends), over 3.
-    j0 += w * (p0 + p1);
-    j1 += w * (p0 * (2.0 * s0 + s1) + p1 * (s0 + 2.0 * s1));
-  };
-  auto argmin = [](double u, double v, double w) {
-    return u <= v ? (u <= w ? 0 : 2) : (v <= w ? 1 : 2);
-  };
-  const int ma = argmin(alpha[0], alpha[1], alpha[2]);
-  const int mb = argmin(alpha[0] + beta[0], alpha[1] + beta[1], alpha[2] + beta[2]);
-  if (ma == mb) {
-    piece(ma, 0.0, 1.0);
-  } else {
-    auto cross_at = [&](int i, int j) {  // s where lines i and j meet, clamped to [0, 1]
-      const double den = beta[j] - beta[i];
-      const double s = den != 0.0 ? (alpha[i] - alpha[j]) / den : 0.0;
-      return std::min(1.0, std::max(0.0, s));
-    };
-    const int mc = 3 - ma - mb;
-    const double s = cross_at(ma, mb);
-    if (alpha[mc] + beta[mc] * s >= alpha[ma] + beta[ma] * s) {
-      piece(ma, 0.0, s);
-      piece(mb, s, 1.0);
-    } else {
-      const double s1 = cross_at(ma, mc), s2 = std::max(s1, cross_at(mc, mb));
-      piece(ma, 0.0, s1);
-      piece(mc, s1, s2);
-      piece(mb, s2, 1.0);
-    }
-  }
-  // phi = 3 lambda: trapezoid 1/2 and Simpson-type 1/6 weights times 3.
-  i0 = 1.5 * j0;
-  i1 = 0.5 * j1;
-}
-
-// Phi_T = int_P phi_T dA by the divergence theorem about a reference point X. On the
-// sub-triangle R_k(T) phi = 3 lambda_k is affine, so div(phi (x - X)) = grad phi . (x - X) +
-// 2 phi = 3 phi - 3 lambda_k(X), and phi (x - X) is continuous across the sub-triangle lines:
-//     Phi = ( oint phi (x - X) . n ds + sum_k 3 lambda_k(X) |P n R_k| ) / 3.
-// R_m is the sub-triangle holding P's centroid. When P stays in R_m, X is the centroid
-// projected onto the line of edge m (lambda_m(X) = 0): no area term at all. When P reaches
-// into R_k too (a strip running into a corner of T), X is the vertex where edges m and k meet
-// (lambda_m = lambda_k = 0 there); only a third sub-triangle, if P reaches it as well, needs
-// its piece (P clipped to R_k, an area ~d^2 for a strip of depth d). Near edge m, phi and
-// (x - X) . n on P's boundary are both ~d and of one sign, so a thin overlap gets Phi to the
-// relative error of its vertices' distances to the edge, ~eps L / d
-// (tests/unit/test_narrow_phase.cpp, ThinStripEnergy*).
-// Replaced: X = G, the centroid of T, where every 3 lambda_k(G) = 1 and the terms sum to the
-// overlap area: Phi = (oint phi (x - G) . n ds + A_P) / 3 needs no clipping but subtracts two
-// quantities of the size of A_P; a strip 1e-12 m deep lost every digit of its energy and came
-// out negative (docs/robustness.md section 2). Tried: each piece P n R_m integrated as a fan
-// of 3 lambda_m (exact and stable, but six clips whenever P reaches a corner of T): 134 k
-// instructions per step of the resting 188-triangle arch against 114 k here and 101 k with
-// the unstable form (callgrind, steps 1000 to 2000).
-struct PhiReference {
-  double x = 0.0, y = 0.0;  // X (local coordinates)
-  double corners = 0.0;     // sum over k of 3 lambda_k(X) |P n R_k|
-};
-
-// (px, py): T's vertices; (cx, cy): P's centroid.
-inline PhiReference phi_reference(const Bary& T, const double* px, const double* py, const Poly& P,
-                                  double cx, double cy) {
+// Field of triangle T (barycentric lam, vertices px, py) over the overlap P, whose area and
+// first moments are mp and centroid (cx, cy), by sub-triangle pieces.
+// On the sub-triangle R_k(T) (lambda_k the smallest coordinate) phi = 3 lambda_k with the
+// constant gradient g_k = 3 grad lambda_k, so with M(Q) = int_Q (1, x, y) dA
+//     G = sum_k g_k (x) M(P n R_k),     Phi = 3 sum_k int_{P n R_k} lambda_k dA.
+// R_m is the sub-triangle holding P's centroid; P n R_m is not formed: it is P less the
+// pieces Q_k = P n R_k of the other sub-triangles P reaches into, so
+//     G   = g_m (x) M(P) + sum_k (g_k - g_m) (x) M(Q_k),
+//     Phi = 3 [ int_P lambda_m dA + sum_k int_{Q_k} (lambda_k - lambda_m) dA ].
+// Q_k is P clipped by lambda_k <= lambda_m, and by lambda_k <= lambda_j as well when P also
+// reaches the third sub-triangle R_j (otherwise the first cut already leaves R_k only). A
+// joint's strip along edge m reaches R_k only in a sliver ~d x d at a corner of T (d: its
+// depth), so the pieces are small and the clips short.
+// int_P lambda_m dA by the fan from a vertex V of edge m (lambda_m(V) = 0): each edge p -> q
+// of P spans the signed triangle (V, p, q), over which the affine lambda_m averages
+// (lambda_m(p) + lambda_m(q)) / 3. Near edge m both the fan triangle's height over the edge
+// line and lambda_m are ~d, so a thin overlap gets Phi to the relative error of its vertices'
+// distances to the edge, ~eps L / d (tests/unit/test_narrow_phase.cpp, ThinStripEnergy*),
+// with no quantity of the overlap's size subtracted (docs/robustness.md section 2).
+inline Field field_over(const Bary& T, const double* px, const double* py, const Poly& P,
+                        const Moments& mp, double cx, double cy) {
   const double l0 = T.lam[0](cx, cy), l1 = T.lam[1](cx, cy), l2 = T.lam[2](cx, cy);
   const int m = l0 <= l1 ? (l0 <= l2 ? 0 : 2) : (l1 <= l2 ? 1 : 2);
-  const Affine& lm = T.lam[m];
-  // Which other sub-triangles P reaches into (P convex: none of R_k when lambda_k is not below
-  // lambda_m, or not below lambda_j, at any vertex of P).
   const int k1 = m == 2 ? 0 : m + 1, k2 = m == 0 ? 2 : m - 1;
+  const Affine& lm = T.lam[m];
+  // lambda_m at P's vertices, and which other sub-triangles P reaches into (P convex: none of
+  // R_k when lambda_k is not below lambda_m, or not below lambda_j, at any vertex of P).
+  double am[kMaxPoly], a1v[kMaxPoly], a2v[kMaxPoly];
+  double depth = 0.0;  // largest lambda_m over P
   bool k1_above_m = true, k1_above_k2 = true, k2_above_m = true, k2_above_k1 = true;
   for (int v = 0; v < P.n; ++v) {
-    const double am = lm(P.x[v], P.y[v]), a1 = T.lam[k1](P.x[v], P.y[v]),
+    const double a = lm(P.x[v], P.y[v]), a1 = T.lam[k1](P.x[v], P.y[v]),
                  a2 = T.lam[k2](P.x[v], P.y[v]);
-    k1_above_m = k1_above_m && a1 >= am;
+    am[v] = a, a1v[v] = a1, a2v[v] = a2;
+    depth = std::max(depth, a);
+    k1_above_m = k1_above_m && a1 >= a;
     k1_above_k2 = k1_above_k2 && a1 >= a2;
-    k2_above_m = k2_above_m && a2 >= am;
+    k2_above_m = k2_above_m && a2 >= a;
     k2_above_k1 = k2_above_k1 && a2 >= a1;
   }
-  bool reaches[3] = {false, false, false};
-  reaches[k1] = !(k1_above_m || k1_above_k2);
-  reaches[k2] = !(k2_above_m || k2_above_k1);
-  PhiReference r;
-  if (!(reaches[k1] || reaches[k2])) {
-    // Within R_m: X = the centroid projected onto edge line m (lambda_m(X) = 0).
-    const double s = (m == 0 ? l0 : (m == 1 ? l1 : l2)) / (lm.b * lm.b + lm.c * lm.c);
-    r.x = cx - s * lm.b;
-    r.y = cy - s * lm.c;
-    return r;
-  }
-  // P reaches a corner of T: X = the vertex where edge m meets the edge of a sub-triangle P
-  // reaches (lambda_m = lambda_k = 0 there), so only the third sub-triangle, if P reaches it
-  // as well, needs its piece.
-  const int k = reaches[k1] ? k1 : k2;
-  const int third = 3 - m - k;  // also the vertex opposite it: on edges m and k
-  r.x = px[third];
-  r.y = py[third];
-  if (reaches[third]) {
-    const Affine& lk = T.lam[third];
-    const Affine& lj = T.lam[k];
-    Poly half, piece;
-    clip(P, {lm.a - lk.a, lm.b - lk.b, lm.c - lk.c}, half);  // lambda_m >= lambda_k
-    clip(half, {lj.a - lk.a, lj.b - lk.b, lj.c - lk.c}, piece);
-    r.corners = 3.0 * lk(r.x, r.y) * moments(piece).area;
-  }
-  return r;
-}
-
-// Field of triangle T (barycentric lam, vertices px, py) over P, by boundary integrals;
-// (cx, cy) P's centroid.
-// phi_T vanishes on T's edges, so only the edges of P lying on the other triangle count
-// (on_c == other_is_c). With n ds = (dy, -dx) ds_param on a counter-clockwise polygon:
-//     int_P grad phi dA     = sum (dy, -dx) I0,
-//     int_P x grad phi dA   = sum (dy, -dx) Ix - (Phi, 0),   (integration by parts)
-//     int_P y grad phi dA   = sum (dy, -dx) Iy - (0, Phi),
-//     Phi = int_P phi dA    = (sum (dy, -dx) . (Ix - X_x I0, Iy - X_y I0) + corners) / 3
-// (phi_reference above).
-inline Field field_over(const Bary& T, const double* px, const double* py, const Poly& P, double cx,
-                        double cy, unsigned char other_is_c) {
-  Field f;
-  const PhiReference ref = phi_reference(T, px, py, P, cx, cy);
-  double j0x = 0.0, j0y = 0.0, jxx = 0.0, jxy = 0.0, jyx = 0.0, jyy = 0.0, k = 0.0;
+  const bool reach1 = !(k1_above_m || k1_above_k2), reach2 = !(k2_above_m || k2_above_k1);
+  // int_P lambda_m dA, fan from V = vertex k1 (on edge m: the edge opposite vertex m).
+  const double vx = px[k1], vy = py[k1];
+  double fan = 0.0;
   for (int q = 0, r = 1; q < P.n; ++q, r = (r + 1 == P.n ? 0 : r + 1)) {
-    if (P.on_c[q] != other_is_c) continue;
-    const double ax = P.x[q], ay = P.y[q], dx = P.x[r] - ax, dy = P.y[r] - ay;
-    double alpha[3], beta[3];
-    for (int m = 0; m < 3; ++m) {
-      alpha[m] = T.lam[m](ax, ay);
-      beta[m] = T.lam[m].b * dx + T.lam[m].c * dy;
-    }
-    double i0, i1;
-    integrate_phi(alpha, beta, i0, i1);
-    const double ix = ax * i0 + dx * i1, iy = ay * i0 + dy * i1;
-    // Outward normal times length: (dy, -dx).
-    j0x += dy * i0;
-    j0y -= dx * i0;
-    jxx += dy * ix;
-    jxy -= dx * ix;
-    jyx += dy * iy;
-    jyy -= dx * iy;
-    k += dy * ((ax - ref.x) * i0 + dx * i1) - dx * ((ay - ref.y) * i0 + dy * i1);
+    const double ux = P.x[q] - vx, uy = P.y[q] - vy, wx = P.x[r] - vx, wy = P.y[r] - vy;
+    fan += (ux * wy - uy * wx) * (am[q] + am[r]);
   }
-  f.phi = (k + ref.corners) * (1.0 / 3.0);
-  f.g[0][0] = j0x;
-  f.g[1][0] = j0y;
-  f.g[0][1] = jxx - f.phi;
-  f.g[1][1] = jxy;
-  f.g[0][2] = jyx;
-  f.g[1][2] = jyy - f.phi;
+  double lam_integral = fan * (1.0 / 6.0);  // (1/2 cross) x (sum / 3)
+  // G row 0: x component of grad phi, row 1: y; columns (1, x, y).
+  const double gmx = 3.0 * lm.b, gmy = 3.0 * lm.c;
+  double gx[3] = {gmx * mp.area, gmx * mp.sx, gmx * mp.sy};
+  double gy[3] = {gmy * mp.area, gmy * mp.sx, gmy * mp.sy};
+  // Where lambda_m <= 1/3 on all of P, lambda_k <= lambda_m implies lambda_j = 1 - lambda_m -
+  // lambda_k >= 1/3 >= lambda_k: the first cut alone leaves R_k (a joint's strip, lambda_m ~
+  // d / h), cut with the vertex values already taken.
+  const bool one_cut = depth <= 1.0 / 3.0;
+  auto add_piece = [&](int k, int j, bool reach_j, const double* ak) {
+    const Affine& lk = T.lam[k];
+    Moments mq;
+    if (!reach_j || one_cut) {
+      double fv[kMaxPoly];
+      for (int v = 0; v < P.n; ++v) fv[v] = am[v] - ak[v];  // lambda_k <= lambda_m
+      mq = clipped_moments(P, fv);
+    } else {
+      const Affine& lj = T.lam[j];
+      Poly half, piece;
+      clip(P, {lm.a - lk.a, lm.b - lk.b, lm.c - lk.c}, half);      // lambda_k <= lambda_m
+      clip(half, {lj.a - lk.a, lj.b - lk.b, lj.c - lk.c}, piece);  // lambda_k <= lambda_j
+      mq = moments(piece);
+    }
+    if (!(mq.area > 0.0)) return;
+    const double da = lk.a - lm.a, db = lk.b - lm.b, dc = lk.c - lm.c;
+    lam_integral += da * mq.area + db * mq.sx + dc * mq.sy;
+    const double dgx = 3.0 * db, dgy = 3.0 * dc;
+    gx[0] += dgx * mq.area, gx[1] += dgx * mq.sx, gx[2] += dgx * mq.sy;
+    gy[0] += dgy * mq.area, gy[1] += dgy * mq.sx, gy[2] += dgy * mq.sy;
+  };
+  if (reach1) add_piece(k1, k2, reach2, a1v);
+  if (reach2) add_piece(k2, k1, reach1, a2v);
+  Field f;
+  f.phi = 3.0 * lam_integral;
+  for (int c = 0; c < 3; ++c) {
+    f.g[0][c] = gx[c];
+    f.g[1][c] = gy[c];
+  }
   return f;
 }
 
@@ -300,7 +259,6 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   for (int k = 0; k < 3; ++k) {
     p0.x[k] = tx[k];
     p0.y[k] = ty[k];
-    p0.on_c[k] = 0;
   }
   clip<3>(p0, ec.e[0], p1);
   if (p1.n < 3) return out;
@@ -315,8 +273,8 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   const Edges et = edge_functions(tx, ty);
   const Bary bc = barycentric(ec), bt = barycentric(et);
   const double c0x = mp.sx / mp.area, c0y = mp.sy / mp.area;  // overlap centroid
-  const Field fc = field_over(bc, cx, cy, P, c0x, c0y, 0);
-  const Field ft = field_over(bt, tx, ty, P, c0x, c0y, 1);
+  const Field fc = field_over(bc, cx, cy, P, mp, c0x, c0y);
+  const Field ft = field_over(bt, tx, ty, P, mp, c0x, c0y);
 
   // Nodal forces: f_i(c) = Ep [(G_c - G_t) l_i^c - Phi_t grad N_i^c], and symmetrically.
   double d[2][3];

@@ -33,23 +33,23 @@
 //     f_i(c) = Ep [ (G_c - G_t) l_i^c - Phi_t grad N_i^c ],
 //     f_j(t) = Ep [ (G_t - G_c) l_j^t - Phi_c grad N_j^t ],   E = Ep (Phi_c + Phi_t).
 //
-// Evaluation (exact, edge-wise). P is obtained by clipping t against c's three edges
-// (Sutherland-Hodgman, convex, at most 6 vertices), remembering for every edge of P whether it
-// lies on an edge of c or of t. By the divergence theorem, with n the outward normal of P,
-//     int_P grad phi dA     = oint phi n ds,
-//     int_P x grad phi dA   = oint x phi n ds - (Phi, 0),     (integration by parts)
-//     int_P y grad phi dA   = oint y phi n ds - (0, Phi),
-// with Phi = int_P phi dA itself from the divergence theorem about a point X on an edge line
-// of the triangle (narrow_phase.cpp, phi_reference: no cancellation at thin overlaps).
-// phi_T vanishes on T's own edges, so in the boundary integrals only the edges of P lying on
-// t count for the field of c, and conversely: one or two segments for a typical contact.
-// Along a segment phi_T = 3 min_m lambda_m is the lower envelope of three lines (concave, at
-// most three pieces), integrated exactly piece by piece (trapezoid and Simpson weights, no
-// quadrature error). This is the edge-wise integration of Munjiza's book carried to the nodal
-// forces: the same boundary integrals give the resultant (his) and the shape-function moments
-// that make the forces the gradient of E (ours). Coordinates are shifted to a local origin
-// (c's first vertex) and P's area and moments are summed as a fan from its own first vertex:
-// overlaps at rest are ~1e-10 m deep and absolute coordinates would cancel catastrophically.
+// Evaluation (exact, by sub-triangle pieces). P is obtained by clipping t against c's three
+// edges (Sutherland-Hodgman, convex, at most 6 vertices); its area and first moments are summed
+// as a fan from its own first vertex. On the sub-triangle R_k(T) phi_T = 3 lambda_k has the
+// constant gradient g_k, so G_T = sum_k g_k (x) int_{P n R_k} (1, x, y) dA. With R_m the
+// sub-triangle holding P's centroid, P n R_m is P less the pieces P n R_k of the other
+// sub-triangles that P reaches into (found from the barycentric coordinates at P's vertices):
+//     G_T   = g_m (x) M(P) + sum_k (g_k - g_m) (x) M(P n R_k),   M(Q) = int_Q (1, x, y) dA,
+//     Phi_T = 3 int_P lambda_m dA + 3 sum_k int_{P n R_k} (lambda_k - lambda_m) dA,
+// each piece P clipped by lambda_k <= lambda_m (and by lambda_k <= lambda_j too, unless
+// lambda_m <= 1/3 on P makes that cut empty). A joint's strip of depth d lies in R_m but for
+// slivers ~d x d at T's corners, so the pieces are small and cut in one pass. int_P lambda_m
+// dA is the fan of P from a vertex of edge m (where lambda_m = 0): near the edge the fan
+// triangles' heights and lambda_m are both ~d, so a thin overlap gets Phi to the relative
+// error of its vertices' distances to the edge, ~eps L / d (narrow_phase.cpp field_over;
+// tests/unit/test_narrow_phase.cpp, ThinStripEnergy*). Coordinates are shifted to a local
+// origin (c's first vertex): overlaps at rest are ~1e-10 m deep and absolute coordinates
+// would cancel catastrophically.
 //
 // Point of action. The forces on c have resultant F and moment M = sum (x F_y - y F_x) about
 // the origin (the area-change term contributes neither); their line of action is
@@ -59,11 +59,17 @@
 // Tried and replaced (same forces to round-off, measured with callgrind on one strip-shaped
 // overlap): splitting P into the three sub-triangle regions by clipping for every integral
 // (~3000 instructions per pair) and a fan of signed triangles from G cut at the sub-triangle
-// lines (~3150); the edge-wise form takes ~2060. Its Phi was first
-// (oint phi (x - G) . n ds + A_P) / 3 with G the centroid of the triangle, which subtracts two
-// quantities of the size of the overlap area: for a resting strip ~1e-12 m deep it lost every
-// digit of the energy (negative values; docs/robustness.md section 2). X on an edge line
-// instead costs 5 to 18% more per strip-shaped overlap (callgrind).
+// lines (~3150), against ~2060 for the edge-wise form that followed (sessions 2 to 17): by
+// the divergence theorem int_P grad phi (x) (1, x, y) dA became integrals of phi along the
+// edges of P lying on the other triangle, where phi = 3 min lambda is the lower envelope of
+// three lines, integrated piece by piece, and Phi came from the divergence theorem about a
+// point on an edge line of T. On church B (session 18) the pieces above take 2009
+// instructions per touching pair against 2313 for the edge-wise form: the envelope
+// integrals cost more than the clips of the rare corner slivers (docs/benchmarks.md,
+// "Session 18"). The first Phi, (oint phi (x - G) . n ds + A_P) / 3 with G the centroid of
+// the triangle, subtracted two quantities of the size of the overlap area: for a resting
+// strip ~1e-12 m deep it lost every digit of the energy (negative values;
+// docs/robustness.md section 2).
 //
 // Negligible overlaps. An overlap smaller than kMinOverlapFraction of the smaller triangle's
 // area counts as no contact (no force, no energy, friction history reset). Such overlaps are
