@@ -33,9 +33,11 @@
 //     f_i(c) = Ep [ (G_c - G_t) l_i^c - Phi_t grad N_i^c ],
 //     f_j(t) = Ep [ (G_t - G_c) l_j^t - Phi_c grad N_j^t ],   E = Ep (Phi_c + Phi_t).
 //
-// Evaluation (exact, by sub-triangle pieces). P is obtained by clipping t against c's three
-// edges (Sutherland-Hodgman, convex, at most 6 vertices); its area and first moments are summed
-// as a fan from its own first vertex. On the sub-triangle R_k(T) phi_T = 3 lambda_k has the
+// Evaluation (exact, edge-wise, by sub-triangle pieces). P is obtained by clipping t against
+// c's three edges (Sutherland-Hodgman, convex, at most 6 vertices); its area and first
+// moments are summed as a fan from its own first vertex. Every integral below is such a sum
+// over the edges of the clipped overlap or of a piece clipped from it (Green's theorem: the
+// edge-wise integration of SPEC.md). On the sub-triangle R_k(T) phi_T = 3 lambda_k has the
 // constant gradient g_k, so G_T = sum_k g_k (x) int_{P n R_k} (1, x, y) dA. With R_m the
 // sub-triangle holding P's centroid, P n R_m is P less the pieces P n R_k of the other
 // sub-triangles that P reaches into (found from the barycentric coordinates at P's vertices):
@@ -59,12 +61,12 @@
 // Tried and replaced (same forces to round-off, measured with callgrind on one strip-shaped
 // overlap): splitting P into the three sub-triangle regions by clipping for every integral
 // (~3000 instructions per pair) and a fan of signed triangles from G cut at the sub-triangle
-// lines (~3150), against ~2060 for the edge-wise form that followed (sessions 2 to 17): by
+// lines (~3150), against ~2060 for the envelope form that followed (sessions 2 to 17): by
 // the divergence theorem int_P grad phi (x) (1, x, y) dA became integrals of phi along the
 // edges of P lying on the other triangle, where phi = 3 min lambda is the lower envelope of
 // three lines, integrated piece by piece, and Phi came from the divergence theorem about a
 // point on an edge line of T. On church B (session 18) the pieces above take 2009
-// instructions per touching pair against 2313 for the edge-wise form: the envelope
+// instructions per touching pair against 2313 for the envelope form: the envelope
 // integrals cost more than the clips of the rare corner slivers (docs/benchmarks.md,
 // "Session 18"). The first Phi, (oint phi (x - G) . n ds + A_P) / 3 with G the centroid of
 // the triangle, subtracted two quantities of the size of the overlap area: for a resting
