@@ -661,7 +661,7 @@ template <bool kFriction, bool kSkin>
 inline bool ContactSystem::Impl::evaluate(std::size_t p, const Nodes& n, double dt, PairResult& r) {
   // A pair that touched at the last step most likely still does: straight to the kernel. The
   // pre-tests below only skip pairs whose kernel certainly gives nothing, so this changes no
-  // result (the kernel then gives nothing itself, and the pair is flagged again below).
+  // result (the kernel then gives nothing itself, and clears the flag).
   if (touched[p]) return evaluate_overlap<kFriction>(p, n, dt, r);
   // Still certainly apart since it was last found so (note_apart): its friction history and
   // damping state were cleared then and nothing has set them since.

@@ -65,9 +65,9 @@
 // the divergence theorem int_P grad phi (x) (1, x, y) dA became integrals of phi along the
 // edges of P lying on the other triangle, where phi = 3 min lambda is the lower envelope of
 // three lines, integrated piece by piece, and Phi came from the divergence theorem about a
-// point on an edge line of T. On church B (session 18) the pieces above take 2009
+// point on an edge line of T. On church B (session 18) the pieces above take 1962
 // instructions per touching pair against 2313 for the envelope form: the envelope
-// integrals cost more than the clips of the rare corner slivers (docs/benchmarks.md,
+// integrals cost more than the one clip of each small corner sliver (docs/benchmarks.md,
 // "Session 18"). The first Phi, (oint phi (x - G) . n ds + A_P) / 3 with G the centroid of
 // the triangle, subtracted two quantities of the size of the overlap area: for a resting
 // strip ~1e-12 m deep it lost every digit of the energy (negative values;
