@@ -449,3 +449,61 @@ TEST(ContactBlocks, ThreadCountDoesNotChangeResults) {
   ASSERT_EQ(one.size(), three.size());
   for (std::size_t k = 0; k < one.size(); ++k) ASSERT_EQ(one[k], three[k]) << "entry " << k;
 }
+
+// A pair that touched at the last step goes to the kernel without the box and edge-line
+// pre-tests (contact/contact.cpp evaluate). Those tests only skip pairs whose kernel gives
+// nothing, so the forces must be those of the long way: the same lattice as above, moved the
+// same way, once detecting only when the broad phase asks (pairs keep their flags) and once
+// detecting again before every evaluation (every flag cleared), gives bit-identical forces,
+// energies and dissipation, with pairs touching and pairs coming apart along the way.
+TEST(ContactBlocks, TouchingPairsSkipThePreTestsWithTheSameForces) {
+  Model base;
+  add_grid_rectangle(base, -0.1, -0.1, 1.5, 0.1, 12, 1, true, "ground", GridDiagonals::Uniform);
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 6; ++i)
+      add_grid_rectangle(base, i * (0.1 - 1e-5), j * (0.1 - 1e-5) - 1e-5, 0.1, 0.1, 1, 1, false,
+                         "block", GridDiagonals::Uniform);
+  base.material.young = 40e9;
+  finalize_model(base);
+  auto run = [&](bool detect_every_time, std::vector<double>& out) {
+    Model m = base;
+    ContactSystem c;
+    ContactParams cp;
+    cp.penalty = 1e12;
+    cp.friction = 0.5;
+    c.setup(m, cp);
+    EnergyLedger ledger;
+    std::int64_t touching = 0, most = 0;
+    for (int it = 0; it < 40; ++it) {
+      for (Index i = 0; i < m.nodes.size(); ++i) {
+        if (m.nodes.inv_mass[i] == 0.0) continue;
+        m.nodes.vx[i] = 1e-3 * std::sin(0.37 * i + it);
+        m.nodes.vy[i] = 1e-3 * std::cos(0.21 * i - it);
+        m.nodes.x[i] += 1e-6 * m.nodes.vx[i];
+        m.nodes.y[i] += 1e-6 * m.nodes.vy[i];
+        if (it >= 20) {  // the lattice spreads: its 1e-5 m overlaps open one after another
+          m.nodes.x[i] += 3e-5 * (m.nodes.x[i] - 0.3);
+          m.nodes.y[i] += 3e-5 * (m.nodes.y[i] - 0.3);
+        }
+      }
+      if (detect_every_time || c.needs_detection(m.nodes)) c.detect(m);
+      std::fill(m.nodes.fx.begin(), m.nodes.fx.end(), 0.0);
+      std::fill(m.nodes.fy.begin(), m.nodes.fy.end(), 0.0);
+      c.add_forces(m, 1e-6, ledger);
+      touching = c.active_pairs();
+      most = std::max(most, touching);
+      out.insert(out.end(), m.nodes.fx.begin(), m.nodes.fx.end());
+      out.insert(out.end(), m.nodes.fy.begin(), m.nodes.fy.end());
+      out.push_back(ledger.contact);
+      out.push_back(ledger.friction_dissipated);
+      out.push_back(static_cast<double>(touching));
+    }
+    EXPECT_GT(most, 20);        // joints pressed at the start
+    EXPECT_LT(touching, most);  // and some of them opened by the end
+  };
+  std::vector<double> kept, cleared;
+  run(false, kept);
+  run(true, cleared);
+  ASSERT_EQ(kept.size(), cleared.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) ASSERT_EQ(kept[k], cleared[k]) << "entry " << k;
+}
