@@ -398,40 +398,69 @@ TEST(ContactBlocks, ShippedBlockSceneOnIncline) {
   }
 }
 
+namespace {
+
+// A lattice of n x n blocks 0.1 m wide on a fixed ground, each pressed 1e-5 m into its
+// neighbours and the ground (E = 40 GPa).
+Model pressed_lattice(int n) {
+  Model m;
+  add_grid_rectangle(m, -0.1, -0.1, 1.5, 0.1, 12, 1, true, "ground", GridDiagonals::Uniform);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      add_grid_rectangle(m, i * (0.1 - 1e-5), j * (0.1 - 1e-5) - 1e-5, 0.1, 0.1, 1, 1, false,
+                         "block", GridDiagonals::Uniform);
+  m.material.young = 40e9;
+  finalize_model(m);
+  return m;
+}
+
+// The lattice's contact: Ep = 1e12 Pa, mu = 0.5.
+ContactSystem lattice_contact(const Model& m) {
+  ContactSystem c;
+  ContactParams cp;
+  cp.penalty = 1e12;
+  cp.friction = 0.5;
+  c.setup(m, cp);
+  return c;
+}
+
+// Moves every free node by a wobble of ~1e-9 m that differs from node to node and from one
+// evaluation `it` to the next (its velocity ~1e-3 m/s over 1e-6 s), so that slip histories
+// evolve.
+void wobble(Model& m, int it) {
+  for (Index i = 0; i < m.nodes.size(); ++i) {
+    if (m.nodes.inv_mass[i] == 0.0) continue;
+    m.nodes.vx[i] = 1e-3 * std::sin(0.37 * i + it);
+    m.nodes.vy[i] = 1e-3 * std::cos(0.21 * i - it);
+    m.nodes.x[i] += 1e-6 * m.nodes.vx[i];
+    m.nodes.y[i] += 1e-6 * m.nodes.vy[i];
+  }
+}
+
+// One contact evaluation at dt = 1e-6 s from zero nodal forces.
+void evaluate_contact(ContactSystem& c, Model& m, EnergyLedger& ledger) {
+  std::fill(m.nodes.fx.begin(), m.nodes.fx.end(), 0.0);
+  std::fill(m.nodes.fy.begin(), m.nodes.fy.end(), 0.0);
+  c.add_forces(m, 1e-6, ledger);
+}
+
+}  // namespace
+
 // Results do not depend on the thread count: a lattice of 12 x 12 blocks pressed into their
 // neighbours (several hundred candidate pairs, above the parallel threshold) with friction;
 // 20 contact evaluations with moving nodes (slip history evolving) give bit-identical forces,
 // energies and dissipation on 1 and on 3 threads.
 TEST(ContactBlocks, ThreadCountDoesNotChangeResults) {
-  Model base;
-  add_grid_rectangle(base, -0.1, -0.1, 1.5, 0.1, 12, 1, true, "ground", GridDiagonals::Uniform);
-  for (int j = 0; j < 12; ++j)
-    for (int i = 0; i < 12; ++i)
-      add_grid_rectangle(base, i * (0.1 - 1e-5), j * (0.1 - 1e-5) - 1e-5, 0.1, 0.1, 1, 1, false,
-                         "block", GridDiagonals::Uniform);
-  base.material.young = 40e9;
-  finalize_model(base);
+  const Model base = pressed_lattice(12);
   auto run = [&](int threads, std::vector<double>& out) {
     omp_set_num_threads(threads);
     Model m = base;
-    ContactSystem c;
-    ContactParams cp;
-    cp.penalty = 1e12;
-    cp.friction = 0.5;
-    c.setup(m, cp);
+    ContactSystem c = lattice_contact(m);
     EnergyLedger ledger;
     for (int it = 0; it < 20; ++it) {
-      for (Index i = 0; i < m.nodes.size(); ++i) {
-        if (m.nodes.inv_mass[i] == 0.0) continue;
-        m.nodes.vx[i] = 1e-3 * std::sin(0.37 * i + it);
-        m.nodes.vy[i] = 1e-3 * std::cos(0.21 * i - it);
-        m.nodes.x[i] += 1e-6 * m.nodes.vx[i];
-        m.nodes.y[i] += 1e-6 * m.nodes.vy[i];
-      }
+      wobble(m, it);
       if (c.needs_detection(m.nodes)) c.detect(m);
-      std::fill(m.nodes.fx.begin(), m.nodes.fx.end(), 0.0);
-      std::fill(m.nodes.fy.begin(), m.nodes.fy.end(), 0.0);
-      c.add_forces(m, 1e-6, ledger);
+      evaluate_contact(c, m, ledger);
     }
     out = m.nodes.fx;
     out.insert(out.end(), m.nodes.fy.begin(), m.nodes.fy.end());
@@ -452,44 +481,27 @@ TEST(ContactBlocks, ThreadCountDoesNotChangeResults) {
 
 // A pair that touched at the last step goes to the kernel without the box and edge-line
 // pre-tests (contact/contact.cpp evaluate). Those tests only skip pairs whose kernel gives
-// nothing, so the forces must be those of the long way: the same lattice as above, moved the
-// same way, once detecting only when the broad phase asks (pairs keep their flags) and once
-// detecting again before every evaluation (every flag cleared), gives bit-identical forces,
-// energies and dissipation, with pairs touching and pairs coming apart along the way.
+// nothing, so the forces must be those of the long way: a pressed lattice, moved the same way,
+// once detecting only when the broad phase asks (pairs keep their flags) and once detecting
+// again before every evaluation (every flag cleared), gives bit-identical forces, energies
+// and dissipation, with pairs touching and pairs coming apart along the way.
 TEST(ContactBlocks, TouchingPairsSkipThePreTestsWithTheSameForces) {
-  Model base;
-  add_grid_rectangle(base, -0.1, -0.1, 1.5, 0.1, 12, 1, true, "ground", GridDiagonals::Uniform);
-  for (int j = 0; j < 6; ++j)
-    for (int i = 0; i < 6; ++i)
-      add_grid_rectangle(base, i * (0.1 - 1e-5), j * (0.1 - 1e-5) - 1e-5, 0.1, 0.1, 1, 1, false,
-                         "block", GridDiagonals::Uniform);
-  base.material.young = 40e9;
-  finalize_model(base);
+  const Model base = pressed_lattice(6);
   auto run = [&](bool detect_every_time, std::vector<double>& out) {
     Model m = base;
-    ContactSystem c;
-    ContactParams cp;
-    cp.penalty = 1e12;
-    cp.friction = 0.5;
-    c.setup(m, cp);
+    ContactSystem c = lattice_contact(m);
     EnergyLedger ledger;
     std::int64_t touching = 0, most = 0;
     for (int it = 0; it < 40; ++it) {
-      for (Index i = 0; i < m.nodes.size(); ++i) {
-        if (m.nodes.inv_mass[i] == 0.0) continue;
-        m.nodes.vx[i] = 1e-3 * std::sin(0.37 * i + it);
-        m.nodes.vy[i] = 1e-3 * std::cos(0.21 * i - it);
-        m.nodes.x[i] += 1e-6 * m.nodes.vx[i];
-        m.nodes.y[i] += 1e-6 * m.nodes.vy[i];
-        if (it >= 20) {  // the lattice spreads: its 1e-5 m overlaps open one after another
+      wobble(m, it);
+      if (it >= 20)  // the lattice spreads: its 1e-5 m overlaps open one after another
+        for (Index i = 0; i < m.nodes.size(); ++i) {
+          if (m.nodes.inv_mass[i] == 0.0) continue;
           m.nodes.x[i] += 3e-5 * (m.nodes.x[i] - 0.3);
           m.nodes.y[i] += 3e-5 * (m.nodes.y[i] - 0.3);
         }
-      }
       if (detect_every_time || c.needs_detection(m.nodes)) c.detect(m);
-      std::fill(m.nodes.fx.begin(), m.nodes.fx.end(), 0.0);
-      std::fill(m.nodes.fy.begin(), m.nodes.fy.end(), 0.0);
-      c.add_forces(m, 1e-6, ledger);
+      evaluate_contact(c, m, ledger);
       touching = c.active_pairs();
       most = std::max(most, touching);
       out.insert(out.end(), m.nodes.fx.begin(), m.nodes.fx.end());
@@ -500,6 +512,7 @@ TEST(ContactBlocks, TouchingPairsSkipThePreTestsWithTheSameForces) {
     }
     EXPECT_GT(most, 20);        // joints pressed at the start
     EXPECT_LT(touching, most);  // and some of them opened by the end
+    EXPECT_GT(ledger.friction_dissipated, 0.0);
   };
   std::vector<double> kept, cleared;
   run(false, kept);
