@@ -144,6 +144,7 @@ inline Moments clipped_moments(const Poly& P, const double* fv) {
 struct Field {
   double g[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
   double phi = 0.0;
+  std::array<double, 3> at_centroid{};  // the barycentric coordinates at P's centroid
 };
 
 // Field of triangle T (barycentric lam, vertices px, py) over the overlap P, whose area and
@@ -227,6 +228,7 @@ inline Field field_over(const Bary& T, const double* px, const double* py, const
   if (reach1) add_piece(k1, k2, reach2, a1v);
   if (reach2) add_piece(k2, k1, reach1, a2v);
   Field f;
+  f.at_centroid = {l0, l1, l2};
   f.phi = 3.0 * lam_integral;
   for (int c = 0; c < 3; ++c) {
     f.g[0][c] = gx[c];
@@ -298,10 +300,8 @@ PairForce triangle_pair_force(const std::array<Vec2, 3>& c, const std::array<Vec
   const double fx = d[0][0], fy = d[1][0];
   const double moment = d[1][1] - d[0][2];  // Ep int (x d_y phi - y d_x phi), c minus t
   const double f2 = fx * fx + fy * fy;
-  for (int i = 0; i < 3; ++i) {
-    out.bary_c[i] = bc.lam[i](c0x, c0y);
-    out.bary_t[i] = bt.lam[i](c0x, c0y);
-  }
+  out.bary_c = fc.at_centroid;
+  out.bary_t = ft.at_centroid;
   out.point = out.centroid;
   if (f2 > 0.0) {
     const double s = (moment - (c0x * fy - c0y * fx)) / f2;
