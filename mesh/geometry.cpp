@@ -51,24 +51,6 @@ double polygon_area(const std::vector<Vec2>& polygon) {
 
 namespace {
 
-// Orientation of c relative to the line a->b: +1 left, -1 right, 0 collinear.
-int orient(Vec2 a, Vec2 b, Vec2 c) {
-  const double d = cross(b - a, c - a);
-  return (d > 0.0) - (d < 0.0);
-}
-
-bool on_segment(Vec2 a, Vec2 b, Vec2 p) {
-  return std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= p.y &&
-         p.y <= std::max(a.y, b.y);
-}
-
-bool segments_touch(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
-  const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
-  if (o1 != o2 && o3 != o4) return true;
-  return (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
-         (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b));
-}
-
 // Clips the convex polygon `poly` by the half-plane left of a->b.
 std::vector<Vec2> clip_left(const std::vector<Vec2>& poly, Vec2 a, Vec2 b) {
   std::vector<Vec2> out;
@@ -87,29 +69,6 @@ std::vector<Vec2> clip_left(const std::vector<Vec2>& poly, Vec2 a, Vec2 b) {
 }
 
 }  // namespace
-
-bool polygon_is_simple(const std::vector<Vec2>& polygon) {
-  const std::size_t n = polygon.size();
-  if (n < 3) return false;
-  for (std::size_t i = 0; i < n; ++i)
-    if (distance(polygon[i], polygon[(i + 1) % n]) == 0.0) return false;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 a = polygon[i], b = polygon[(i + 1) % n];
-    for (std::size_t j = i + 1; j < n; ++j) {
-      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
-      const Vec2 c = polygon[j], d = polygon[(j + 1) % n];
-      if (adjacent) {
-        // Adjacent edges share one vertex; they must not fold back onto each other.
-        const Vec2 shared = j == i + 1 ? b : a;
-        const Vec2 u = (j == i + 1 ? a : b) - shared, v = (j == i + 1 ? d : c) - shared;
-        if (cross(u, v) == 0.0 && dot(u, v) > 0.0) return false;
-        continue;
-      }
-      if (segments_touch(a, b, c, d)) return false;
-    }
-  }
-  return true;
-}
 
 double triangle_overlap_area(const std::array<Vec2, 3>& t1, const std::array<Vec2, 3>& t2) {
   std::vector<Vec2> poly(t1.begin(), t1.end());

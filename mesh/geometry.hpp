@@ -51,8 +51,9 @@ Outline mirror_outline(const Outline& outline);
 
 // Signed area of a polygon (positive when counter-clockwise) [m2].
 double polygon_area(const std::vector<Vec2>& polygon);
-// True when no two non-adjacent edges of the closed polygon touch or cross and no edge has
-// zero length.
+// True when no two non-adjacent edges of the closed polygon touch or cross, no edge has zero
+// length and no edge folds back onto its neighbour. Exact (CGAL's sweep, O(n log n));
+// defined in mesh/triangulate_cgal.cpp, where CGAL is confined.
 bool polygon_is_simple(const std::vector<Vec2>& polygon);
 
 // The corners of a closed polygon: every vertex that lies on the straight line through its

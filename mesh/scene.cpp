@@ -25,6 +25,22 @@ namespace {
 // exhaust memory before the user sees anything.
 constexpr double kMaxTriangles = 4e6;
 
+// The mesh of one polygon block is refused once it grows past this many times the estimate of
+// the triangle budget (5 area / size^2), plus a floor for small blocks: a quality mesh grows far
+// beyond its area's share only where the outline is much thinner than the element size (a
+// sliver, a needle corner, a narrow slot), and there it may not stop (slow fuzz tier, session
+// 19: a polygon file's block drawn 65 km long and 0.25 m high kept `check` busy for minutes).
+constexpr double kPolygonMeshSlack = 10.0;
+constexpr double kPolygonMeshFloor = 1e4;
+
+std::size_t polygon_mesh_cap(const BlockSpec& b) {
+  if (b.mesher != BlockSpec::Mesher::Polygon && b.mesher != BlockSpec::Mesher::SymmetricPolygon)
+    return 0;
+  const double estimate = 5.0 * std::abs(outline_area(b.outline)) / (b.size * b.size);
+  return static_cast<std::size_t>(
+      std::min(kPolygonMeshSlack * estimate + kPolygonMeshFloor, kMaxTriangles));
+}
+
 std::string format_number(double v) {
   std::ostringstream s;
   s.precision(10);
@@ -119,20 +135,26 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
   check_triangle_budget(params, estimate);
 
   // Mesh every block that is not a mirror first, then the mirrors.
-  for (BlockSpec& b : scene.blocks) {
-    switch (b.mesher) {
-      case BlockSpec::Mesher::Band:
-        b.mesh = mesh_band(b.columns);
-        break;
-      case BlockSpec::Mesher::Polygon:
-        b.mesh = triangulate_polygon(b.boundary, b.size);
-        break;
-      case BlockSpec::Mesher::SymmetricPolygon:
-        b.mesh = triangulate_symmetric(b.boundary, b.size);
-        break;
-      case BlockSpec::Mesher::Mirror:
-      case BlockSpec::Mesher::Given:
-        break;
+  for (std::size_t i = 0; i < scene.blocks.size(); ++i) {
+    BlockSpec& b = scene.blocks[i];
+    const std::size_t cap = polygon_mesh_cap(b);
+    try {
+      switch (b.mesher) {
+        case BlockSpec::Mesher::Band:
+          b.mesh = mesh_band(b.columns);
+          break;
+        case BlockSpec::Mesher::Polygon:
+          b.mesh = triangulate_polygon(b.boundary, b.size, cap);
+          break;
+        case BlockSpec::Mesher::SymmetricPolygon:
+          b.mesh = triangulate_symmetric(b.boundary, b.size, cap);
+          break;
+        case BlockSpec::Mesher::Mirror:
+        case BlockSpec::Mesher::Given:
+          break;
+      }
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error("block " + std::to_string(i) + ": " + e.what());
     }
   }
   for (BlockSpec& b : scene.blocks) {

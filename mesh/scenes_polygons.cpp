@@ -6,8 +6,9 @@
 // 1. Polygon text file. One vertex `x y` per line (a comma may separate them); a block ends at
 //    a blank line or at a line `block`, which may also start the file; `#` starts a comment;
 //    a last vertex repeating the first is dropped. Each block must be a simple polygon (any
-//    orientation, convex or not) with at least three vertices; blocks may touch and share
-//    edges but not overlap. Blocks are numbered from 0 in file order. Example:
+//    orientation, convex or not) with at least three vertices and no corner sharper than 1
+//    degree (nor a notch narrower); blocks may touch and share edges but not overlap. Blocks are
+//    numbered from 0 in file order. Example:
 //        # ground, then a block on it
 //        block
 //        -2 -0.5
@@ -50,6 +51,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -75,16 +77,43 @@ std::string trim(const std::string& s) {
 
 // ---- polygon text files ----
 
+// A corner sharper than this, or a notch narrower (interior angle above 360 degrees minus it),
+// is refused: near it the two edges run closer than any element size for a long way, and the
+// constrained triangulation of the refined outline grows without bound there (slow fuzz tier,
+// session 19: a vertex moved to x = 65536 made a 4e-6 rad needle that kept `check` busy for
+// minutes). Drawn masonry has no such corners; a stray or mistyped vertex does.
+constexpr double kMinCornerDeg = 1.0;
+
+void check_corners(const std::vector<Vec2>& p, const std::vector<int>& lines,
+                   const std::string& name, std::size_t block) {
+  const std::size_t n = p.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 u = p[(i + 1) % n] - p[i], v = p[(i + n - 1) % n] - p[i];
+    double interior = std::atan2(cross(u, v), dot(u, v)) * 180.0 / std::numbers::pi;
+    if (interior < 0.0) interior += 360.0;  // counter-clockwise polygon: a reflex corner
+    if (interior >= kMinCornerDeg && interior <= 360.0 - kMinCornerDeg) continue;
+    std::ostringstream why;
+    why.precision(6);
+    why << name << ":" << lines[i] << ": block " << block << ": the corner at vertex (" << p[i].x
+        << ", " << p[i].y << ") is " << (interior < 180.0 ? "a needle of " : "a notch of ")
+        << (interior < 180.0 ? interior : 360.0 - interior)
+        << " degrees; corners and notches under " << kMinCornerDeg
+        << " degree cannot be meshed (check that vertex and its neighbours)";
+    throw FileError{why.str()};
+  }
+}
+
 std::vector<std::vector<Vec2>> read_polygon_text(const std::string& text, const std::string& name) {
   std::vector<std::vector<Vec2>> blocks;
+  std::vector<std::vector<int>> vertex_lines;
   std::vector<Vec2> cur;
-  std::vector<int> first_line;
-  int cur_line = 0;
+  std::vector<int> cur_lines;
   auto close = [&]() {
     if (!cur.empty()) {
       blocks.push_back(cur);
-      first_line.push_back(cur_line);
+      vertex_lines.push_back(cur_lines);
       cur.clear();
+      cur_lines.clear();
     }
   };
   std::istringstream in(text);
@@ -114,22 +143,30 @@ std::vector<std::vector<Vec2>> read_polygon_text(const std::string& text, const 
     if (!(v >> x >> y) || (v >> extra) || !std::isfinite(x) || !std::isfinite(y))
       throw FileError{name + ":" + std::to_string(ln) + ": expected a vertex 'x y', got '" + s +
                       "'"};
-    if (cur.empty()) cur_line = ln;
     cur.push_back({x, y});
+    cur_lines.push_back(ln);
   }
   close();
   if (blocks.empty()) throw FileError{name + ": no blocks (expected lines 'x y')"};
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     std::vector<Vec2>& p = blocks[b];
-    if (p.size() > 1 && p.front().x == p.back().x && p.front().y == p.back().y) p.pop_back();
+    std::vector<int>& lines = vertex_lines[b];
+    if (p.size() > 1 && p.front().x == p.back().x && p.front().y == p.back().y) {
+      p.pop_back();
+      lines.pop_back();
+    }
     const std::string where =
-        name + ":" + std::to_string(first_line[b]) + ": block " + std::to_string(b) + ": ";
+        name + ":" + std::to_string(lines.front()) + ": block " + std::to_string(b) + ": ";
     if (p.size() < 3)
       throw FileError{where + "a block needs at least 3 vertices, got " + std::to_string(p.size())};
     if (!polygon_is_simple(p))
       throw FileError{where +
                       "the polygon is not simple (edges cross or touch, or a vertex repeats)"};
-    if (polygon_area(p) < 0.0) std::reverse(p.begin(), p.end());
+    if (polygon_area(p) < 0.0) {
+      std::reverse(p.begin(), p.end());
+      std::reverse(lines.begin(), lines.end());
+    }
+    check_corners(p, lines, name, b);
   }
   return blocks;
 }

@@ -35,8 +35,10 @@ struct TriMesh {
 TriMesh mesh_band(const std::vector<std::vector<Vec2>>& columns);
 
 // Quality mesh of a simple counter-clockwise polygon; `size` bounds the longest edge [m].
-// Throws std::invalid_argument if the polygon is not simple.
-TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size);
+// Throws std::invalid_argument if the polygon is not simple, and std::runtime_error once the
+// mesh grows past `max_triangles` (0: no limit).
+TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size,
+                            std::size_t max_triangles = 0);
 
 // Convex hull of a point set, counter-clockwise, without collinear points (CGAL::convex_hull_2;
 // here because CGAL is confined to mesh/triangulate_cgal.cpp).
@@ -46,7 +48,9 @@ std::vector<Vec2> convex_hull(const std::vector<Vec2>& points);
 // `right_chain` (counter-clockwise, from a point with x == 0 through points with x > 0 to
 // another point with x == 0) and by the axis between those two points; the mesh of the left
 // half is the exact mirror image.
-TriMesh triangulate_symmetric(const std::vector<Vec2>& right_chain, double size);
+// `max_triangles` bounds the half's mesh as in triangulate_polygon.
+TriMesh triangulate_symmetric(const std::vector<Vec2>& right_chain, double size,
+                              std::size_t max_triangles = 0);
 
 // Mirror image of a mesh in x = 0 (same node and triangle order).
 TriMesh mirror_mesh(const TriMesh& mesh);

@@ -80,6 +80,17 @@ TEST(Geometry, SimplePolygons) {
   EXPECT_FALSE(polygon_is_simple({{0, 0}, {1, 1}, {1, 0}, {0, 1}}));         // bow tie
   EXPECT_FALSE(polygon_is_simple({{0, 0}, {1, 0}, {1, 0}, {0, 1}}));         // repeated vertex
   EXPECT_FALSE(polygon_is_simple({{0, 0}, {2, 0}, {1, 0}, {1, 1}}));         // folds back
+  EXPECT_FALSE(polygon_is_simple({{0, 0}, {2, 0}, {2, 2}, {1, 0}, {0, 2}}));  // vertex on an edge
+  // A needle: the outline of a 16 km block tapering to a 1.5e-5 rad tip, cut at 1 m. The
+  // inexact pairwise test that came before the sweep called it crossed: two pieces of its
+  // slanted long edge, 1 km apart and collinear but for rounding, got opposite orientation
+  // signs (pieces 17157 and 18183).
+  const std::vector<Vec2> corners = {{16384, 0}, {0.25, 0}, {0.25, 1}, {-0.25, 1}, {-1.75, -0.25}};
+  std::vector<Vec2> needle;
+  for (std::size_t k = 0; k < corners.size(); ++k)
+    append_segment(needle, corners[k], corners[(k + 1) % corners.size()], 1.0);
+  EXPECT_GT(needle.size(), 32000u);
+  EXPECT_TRUE(polygon_is_simple(needle));
   EXPECT_NEAR(polygon_area({{0, 0}, {2, 0}, {2, 2}, {1, 1}, {0, 2}}), 3.0, 1e-15);
 }
 
@@ -155,6 +166,22 @@ TEST(Triangulate, NonConvexPolygonKeepsBoundaryAndQuality) {
   std::vector<Vec2> cw(ell.rbegin(), ell.rend());
   EXPECT_THROW(triangulate_polygon(cw, 0.1), std::invalid_argument);
   EXPECT_THROW(triangulate_polygon({{0, 0}, {1, 1}, {1, 0}, {0, 1}}, 0.1), std::invalid_argument);
+}
+
+TEST(Triangulate, GrowthPastTheCapIsRefused) {
+  // A strip 100 times longer than thick, meshed at 10 times its thickness: quality triangles
+  // must be about as small as the thickness, far more than its area calls for.
+  const std::vector<Vec2> strip = {{0, 0}, {1, 0}, {1, 0.01}, {0, 0.01}};
+  const TriMesh free = triangulate_polygon(strip, 0.1);
+  ASSERT_GT(free.tris.size(), 100u);
+  // A cap at the mesh's own size does not change it; one triangle less stops the mesher.
+  const TriMesh capped = triangulate_polygon(strip, 0.1, free.tris.size());
+  ASSERT_EQ(capped.tris.size(), free.tris.size());
+  for (std::size_t k = 0; k < free.points.size(); ++k) {
+    EXPECT_EQ(capped.points[k].x, free.points[k].x);
+    EXPECT_EQ(capped.points[k].y, free.points[k].y);
+  }
+  EXPECT_THROW(triangulate_polygon(strip, 0.1, free.tris.size() - 1), std::runtime_error);
 }
 
 TEST(Triangulate, HorizontalEdgeSteinerPointsAreExactlyOnTheEdge) {
