@@ -36,7 +36,8 @@ TriMesh mesh_band(const std::vector<std::vector<Vec2>>& columns);
 
 // Quality mesh of a simple counter-clockwise polygon; `size` bounds the longest edge [m].
 // Throws std::invalid_argument if the polygon is not simple, and std::runtime_error once the
-// mesh grows past `max_triangles` (0: no limit).
+// triangulation grows past `max_triangles` (0: no limit; the count includes the faces
+// between the polygon and its convex hull, and one per hull edge).
 TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size,
                             std::size_t max_triangles = 0);
 

@@ -131,7 +131,9 @@ TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size,
   mesher.init();
   while (!mesher.is_refinement_done()) {
     mesher.step_by_step_refine_mesh();
-    if (max_triangles > 0 && cdt.number_of_faces() > max_triangles) {
+    // The data structure's count, O(1), includes the faces on the infinite vertex (one per
+    // convex-hull edge); the triangulation's own count walks them at every call.
+    if (max_triangles > 0 && cdt.tds().number_of_faces() > max_triangles) {
       std::ostringstream why;
       why << "its quality mesh at element size " << size << " m exceeds " << max_triangles
           << " triangles: the outline is far thinner than the element size somewhere (a sliver,"
