@@ -153,7 +153,12 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
         case BlockSpec::Mesher::Given:
           break;
       }
-    } catch (const std::runtime_error& e) {
+    } catch (const std::exception& e) {
+      // The block is named in build_model's report; a deck error and a mesh that does not fit
+      // in memory keep their own reports there.
+      if (dynamic_cast<const DeckError*>(&e) || dynamic_cast<const std::bad_alloc*>(&e) ||
+          dynamic_cast<const std::length_error*>(&e))
+        throw;
       throw std::runtime_error("block " + std::to_string(i) + ": " + e.what());
     }
   }

@@ -1,6 +1,6 @@
 // The only file that includes CGAL: quality constrained Delaunay meshing of a simple polygon,
-// and the convex hull that mesh/minimal.cpp takes the width of long outlines from (contracts
-// in triangulate.hpp).
+// the convex hull that mesh/minimal.cpp takes the width of long outlines from (contracts in
+// triangulate.hpp), and the exact simplicity test of mesh/geometry.hpp.
 //
 // Kernel: exact predicates, inexact constructions. Input points are stored as given, so every
 // boundary point becomes a node bit for bit. The mesher adds Steiner points: circumcentres
@@ -24,7 +24,6 @@
 #include <CGAL/convex_hull_2.h>
 
 #include <iterator>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 
