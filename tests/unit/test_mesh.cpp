@@ -177,6 +177,7 @@ TEST(Triangulate, GrowthPastTheCapIsRefused) {
   // A cap well above the mesh's size does not change it; one at half its size stops the mesher.
   const TriMesh capped = triangulate_polygon(strip, 0.1, 10 * free.tris.size());
   ASSERT_EQ(capped.tris.size(), free.tris.size());
+  ASSERT_EQ(capped.points.size(), free.points.size());
   for (std::size_t k = 0; k < free.points.size(); ++k) {
     EXPECT_EQ(capped.points[k].x, free.points[k].x);
     EXPECT_EQ(capped.points[k].y, free.points[k].y);
