@@ -48,7 +48,10 @@ const std::map<std::string, std::string>& meanings() {
       {"model.incline", "block: incline of the fixed ground"},
       {"model.stack", "block: number of blocks stacked on the ground"},
       {"model.file",
-       "polygons: polygon text file or gmsh MSH 4.1 file of the blocks (docs/gmsh.md)"},
+       "polygons: polygon text file or gmsh MSH 4.1 file of the blocks (docs/gmsh.md); a text "
+       "file's block must be a simple polygon with no corner sharper than 1 degree and no notch "
+       "narrower (refused naming the file's line, the block and the vertex; format: "
+       "mesh/scenes_polygons.cpp)"},
       {"model.fixed",
        "polygons: indices of the fixed blocks (file order; gmsh: physical tag order); at least "
        "one block must stay free"},
