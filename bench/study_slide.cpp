@@ -8,15 +8,19 @@
 // (joint forces + weight + lambda weight: zero for a block in static equilibrium; in a steady
 // creep it is the mean force that something else -- the local damping -- supplies).
 // Written to diagnose the sliding semicircular arch at beta = 120, mu = 0.6 (rigid against
-// elastic blocks, physical against quasi-static trials).
+// elastic blocks, physical against quasi-static trials). Each sample also gives the
+// unbalanced-force ratio R (after "R=": the largest out-of-balance load of a free block over
+// its weight, below), the block it is largest on, and the steps since the last sample that
+// ended with the kinetic damping's peak cleared ("resets="): the study of an unbalanced-force
+// rest rule, docs/capacity.md "The unbalanced-force ratio".
 //
 //   build/study_slide DECK LAMBDA [--set KEY=VALUE ...] [--end T] [--every T]
-//       [--qs-settle A] [--qs-trial A] [--mode outgoing|full] [--qs-off T] [--avg-from T]
-//       [--joint J ...]
+//       [--qs-settle A] [--qs-trial A] [--mode outgoing|full] [--qs-off T] [--kd-off T]
+//       [--avg-from T] [--joint J ...]
 // --qs-settle A / --qs-trial A: Cundall local damping coefficient of the settle / of the trial
 // (0, the default: physical); --qs-off T: the trial's local damping switched off at trial time
-// T; --end: trial length [s] (default 1.5); --every: sampling period [s] (default 0.01);
-// --joint: joints to print (default: the two springings). With --qs-settle, the kinetic
+// T; --kd-off T: its kinetic damping switched off at trial time T; --end: trial length [s]
+// (default 1.5); --every: sampling period [s] (default 0.01); --joint: joints to print (default: the two springings). With --qs-settle, the kinetic
 // damping of the deck's capacity.kinetic_damping acts in the settle and the trial as in
 // `capacity` (--set capacity.kinetic_damping=0: the local damping alone), and the rest rule
 // refuses a creep as there.
@@ -36,6 +40,52 @@
 
 using namespace voussoir;
 
+namespace {
+
+// How far the free blocks are from static equilibrium: per rigid block, its resultant force
+// and its moment over its radius of gyration, each against the block's weight (the nodes'
+// lumped masses: the true weight, whatever the quasi-static mass scaling did to the body);
+// per free node of elastic blocks, its force against its weight. The forces are those of the
+// last step (contact, elements and body loads; the local damping is added inside the update
+// and is not in them): zero in equilibrium.
+struct Unbalance {
+  double ratio = 0.0;          // the largest of the two ratios over the blocks (nodes)
+  std::size_t where = 0;       // the block (rigid) or node (elastic) where it is largest
+  double force = 0.0, moment = 0.0;  // its two ratios there (rigid)
+};
+
+Unbalance unbalanced_force_ratio(const Model& m, double g) {
+  const Nodes& n = m.nodes;
+  Unbalance u;
+  if (!m.is_rigid()) {
+    for (Index i = 0; i < n.size(); ++i) {
+      if (n.inv_mass[i] == 0.0) continue;
+      const double r = std::hypot(n.fx[i], n.fy[i]) / (n.mass[i] * g);
+      if (r > u.ratio) u.ratio = u.force = r, u.where = std::size_t(i);
+    }
+    return u;
+  }
+  for (std::size_t b = 0; b < m.blocks.size(); ++b) {
+    const Block& blk = m.blocks[b];
+    if (blk.fixed || !(m.rigid.mass[b] > 0.0)) continue;
+    double fx = 0.0, fy = 0.0, torque = 0.0, mass = 0.0;
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+      fx += n.fx[i];
+      fy += n.fy[i];
+      torque += (n.x[i] - m.rigid.cx[b]) * n.fy[i] - (n.y[i] - m.rigid.cy[b]) * n.fx[i];
+      mass += n.mass[i];
+    }
+    const double gyration = std::sqrt(m.rigid.inertia[b] / m.rigid.mass[b]);
+    const double force = std::hypot(fx, fy) / (mass * g);
+    const double moment = std::abs(torque) / (gyration * mass * g);
+    if (std::max(force, moment) > u.ratio)
+      u = {std::max(force, moment), b, force, moment};
+  }
+  return u;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   if (argc < 3) {
     std::fprintf(stderr, "usage: study_slide DECK LAMBDA [options]\n");
@@ -43,7 +93,7 @@ int main(int argc, char** argv) {
   }
   const std::string deck = argv[1];
   const double lambda = std::atof(argv[2]);
-  double qs_settle = 0.0, qs_trial = 0.0, end = 1.5, every = 0.01, qs_off = 1e30, avg_from = 1e30;
+  double qs_settle = 0.0, qs_trial = 0.0, end = 1.5, every = 0.01, qs_off = 1e30, avg_from = 1e30, kd_off = 1e30;
   std::string mode = "outgoing";
   std::vector<std::string> sets;
   std::vector<int> show_joints;
@@ -56,6 +106,7 @@ int main(int argc, char** argv) {
     else if (a == "--mode") mode = argv[++i];
     else if (a == "--qs-off") qs_off = std::atof(argv[++i]);
     else if (a == "--avg-from") avg_from = std::atof(argv[++i]);
+    else if (a == "--kd-off") kd_off = std::atof(argv[++i]);
     else if (a == "--set") sets.push_back(argv[++i]);
     else if (a == "--joint") show_joints.push_back(std::atoi(argv[++i]));
     else {
@@ -109,6 +160,9 @@ int main(int argc, char** argv) {
               mu, d_collapse, v_rest, m.joints.size(), m.blocks.size());
   std::printf("# t  KE  speed  maxdisp  maxrot  | per joint: slip  open_a  open_b  N  V  V/(muN)\n");
   long avg_n = 0;
+  // Steps that end with the kinetic damping's peak cleared: the step of a reset and the one
+  // after it (its kinetic energy is 0).
+  long resets = 0;
   std::vector<double> res_x(m.blocks.size(), 0.0), res_y(m.blocks.size(), 0.0);
   std::vector<double> jn(m.joints.size(), 0.0), jv(m.joints.size(), 0.0);
   spec.on_sample = [&](const Simulation& S, const Probe& p) {
@@ -131,8 +185,9 @@ int main(int argc, char** argv) {
         jn[j] += jr[j].normal_force, jv[j] += jr[j].shear_force;
       }
     }
-    std::printf("%.4f %.3e %.3e %.4e %.4e W=%.4e Df=%.4e Dl=%.4e Di=%.4e |", p.time,
-                S.ledger.kinetic, p.speed, p.motion.displacement, p.motion.rotation,
+    const Unbalance unbalance = unbalanced_force_ratio(S.model, g);
+    std::printf("%.4f %.3e R=%.3e %.3e %.4e %.4e W=%.4e Df=%.4e Dl=%.4e Di=%.4e |", p.time,
+                S.ledger.kinetic, unbalance.ratio, p.speed, p.motion.displacement, p.motion.rotation,
                 S.ledger.external_work, S.ledger.friction_dissipated, S.ledger.local_dissipated,
                 S.ledger.impact_dissipated);
     for (int j : show_joints) {
@@ -142,11 +197,19 @@ int main(int argc, char** argv) {
                   r.normal_force, r.shear_force,
                   r.normal_force > 0 ? std::abs(r.shear_force) / (mu * r.normal_force) : 0.0);
     }
-    std::printf("\n");
+    std::printf(" worst %s %zu F/W=%.3e M/(W rg)=%.3e", S.model.is_rigid() ? "block" : "node",
+                unbalance.where, unbalance.force, unbalance.moment);
+    std::printf(" resets=%ld\n", resets);
+    resets = 0;
     std::fflush(stdout);
     return true;
   };
   spec.on_step = [&](const Simulation& S, const StepInfo&) {
+    if (S.ctx.kinetic_damping > 0.0 && S.kinetic_peak == 0.0) ++resets;
+    if (S.ctx.time - spec.loads->start >= kd_off && S.ctx.kinetic_damping > 0.0) {
+      const_cast<Simulation&>(S).ctx.kinetic_damping = 0.0;  // study: kinetic damping off
+      std::printf("# kinetic damping switched off at %.4f\n", S.ctx.time - spec.loads->start);
+    }
     if (S.ctx.time - spec.loads->start >= qs_off && S.ctx.local_damping > 0.0) {
       const_cast<Simulation&>(S).ctx.local_damping = 0.0;  // study: damping off from qs_off on
       std::printf("# local damping switched off at %.4f\n", S.ctx.time - spec.loads->start);
