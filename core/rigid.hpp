@@ -46,16 +46,13 @@ namespace voussoir {
 // run stopped by the 5% guard (docs/rigid.md, "The stable step of rigid blocks"). So 0.4:
 // omega dt = 0.72, about nine steps per period of the stiffest joint mode.
 inline constexpr double kRigidStepFraction = 0.4;
-// The quasi-static settle and trials of `capacity` and `sweep` (drivers/capacity.cpp settle;
-// local and kinetic damping, docs/capacity.md) take a longer step: 0.5 of 2 / omega, with
-// solver.dt_safety, omega dt = 0.9. The fraction above is set by the energy a one-sided
-// contact gains when it opens and closes, with nothing to take it out (a physical run); there
-// the damping takes it out (docs/rigid.md, "Session 16: 0.5 in the quasi-static phases"):
-// over the 22 regression searches the largest trial balance error goes from 4.1e-5 to 7.0e-5,
-// 19 keep every verdict and three rise by one bracket step, in 20% fewer steps; at 0.6 church
-// B's settle trips the 5% energy guard (0.052). Not with impact damping (its dashpots need
-// their own fraction below), nor with a deck's dt.
-inline constexpr double kQuasiStaticRigidStepFraction = 0.5;
+// The quasi-static settle and trials of `capacity` and `sweep` take the same fraction. From
+// session 16 to 19 they took 0.5 (omega dt = 0.9), and that froze trials: the bound omega is
+// per body, the joints couple the bodies into modes up to about 1.3 times faster, and at 0.5
+// such a mode turns within one step (omega dt > 1). The kinetic damping then resets the
+// velocities at every step, and a structure that is not in equilibrium stands still and is
+// called at rest. It happened on church B, and on the buttressed arches at beta 150, whose
+// lambda* it raised by 0.37% (docs/capacity.md, "The kinetic damping froze trials at 0.5").
 // With impact damping (contact.restitution < 1) the dashpot, which acts on the rate of the
 // normal force, must resolve the impact: at the fraction above a drop's rebound misses e^2 by
 // more, so its steps stay at 0.2 (docs/rigid.md, "Impact damping").

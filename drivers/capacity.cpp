@@ -14,7 +14,6 @@
 #include <nlohmann/json.hpp>
 
 #include "core/fnv.hpp"
-#include "core/rigid.hpp"
 #include "drivers/bracket.hpp"
 #include "drivers/journal.hpp"
 #include "drivers/motion.hpp"
@@ -49,11 +48,6 @@ SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet)
                      scaled.blocks, scaled.smallest);
     }
   }
-  // Rigid blocks without impact damping take the quasi-static step (core/rigid.hpp
-  // kQuasiStaticRigidStepFraction), unless the deck gives its own dt.
-  const bool longer_step = crit.quasi_static && s.sim.model.is_rigid() &&
-                           !(config.solver.dt > 0.0) && !(s.sim.contact.params().restitution < 1.0);
-  if (longer_step) s.sim.ctx.dt *= kQuasiStaticRigidStepFraction / kRigidStepFraction;
   s.gravity = config.load.gravity;
   s.l_ref = reference_length(s.sim.model);
   Simulation& sim = s.sim;

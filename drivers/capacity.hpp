@@ -27,8 +27,8 @@
 // (core/integrate.hpp KineticDamping: a slow sway stopped at its equilibrium), rigid and
 // elastic blocks alike; with rigid blocks the settle (whose state every trial starts from)
 // also lowers the slow blocks' inertia to the model's step when capacity.mass_scaling is
-// "equalize" (core/step.hpp equalize_rigid_inertia; the loads keep the true masses), and
-// takes the quasi-static step of rigid blocks (core/rigid.hpp kQuasiStaticRigidStepFraction).
+// "equalize" (core/step.hpp equalize_rigid_inertia; the loads keep the true masses); the step
+// is the physical one (core/rigid.hpp kRigidStepFraction: why not longer).
 // On a rigid sliding mechanism the damping does not arrest the slide, it slows it to a steady
 // creep below the rest speed;
 // before the creep check the rest rule took that creep for rest and lambda* of the sliding
