@@ -20,10 +20,10 @@
 // --qs-settle A / --qs-trial A: Cundall local damping coefficient of the settle / of the trial
 // (0, the default: physical); --qs-off T: the trial's local damping switched off at trial time
 // T; --kd-off T: its kinetic damping switched off at trial time T; --end: trial length [s]
-// (default 1.5); --every: sampling period [s] (default 0.01); --joint: joints to print (default: the two springings). With --qs-settle, the kinetic
-// damping of the deck's capacity.kinetic_damping acts in the settle and the trial as in
-// `capacity` (--set capacity.kinetic_damping=0: the local damping alone), and the rest rule
-// refuses a creep as there.
+// (default 1.5); --every: sampling period [s] (default 0.01); --joint: joints to print (default:
+// the two springings). With --qs-settle, the kinetic damping of the deck's capacity.kinetic_damping
+// acts in the settle and the trial as in `capacity` (--set capacity.kinetic_damping=0: the local
+// damping alone), and the rest rule refuses a creep as there.
 
 #include <cmath>
 #include <cstdio>
@@ -49,8 +49,8 @@ namespace {
 // last step (contact, elements and body loads; the local damping is added inside the update
 // and is not in them): zero in equilibrium.
 struct Unbalance {
-  double ratio = 0.0;          // the largest of the two ratios over the blocks (nodes)
-  std::size_t where = 0;       // the block (rigid) or node (elastic) where it is largest
+  double ratio = 0.0;                // the largest of the two ratios over the blocks (nodes)
+  std::size_t where = 0;             // the block (rigid) or node (elastic) where it is largest
   double force = 0.0, moment = 0.0;  // its two ratios there (rigid)
 };
 
@@ -78,8 +78,7 @@ Unbalance unbalanced_force_ratio(const Model& m, double g) {
     const double gyration = std::sqrt(m.rigid.inertia[b] / m.rigid.mass[b]);
     const double force = std::hypot(fx, fy) / (mass * g);
     const double moment = std::abs(torque) / (gyration * mass * g);
-    if (std::max(force, moment) > u.ratio)
-      u = {std::max(force, moment), b, force, moment};
+    if (std::max(force, moment) > u.ratio) u = {std::max(force, moment), b, force, moment};
   }
   return u;
 }
@@ -93,7 +92,8 @@ int main(int argc, char** argv) {
   }
   const std::string deck = argv[1];
   const double lambda = std::atof(argv[2]);
-  double qs_settle = 0.0, qs_trial = 0.0, end = 1.5, every = 0.01, qs_off = 1e30, avg_from = 1e30, kd_off = 1e30;
+  double qs_settle = 0.0, qs_trial = 0.0, end = 1.5, every = 0.01, qs_off = 1e30, avg_from = 1e30,
+         kd_off = 1e30;
   std::string mode = "outgoing";
   std::vector<std::string> sets;
   std::vector<int> show_joints;
@@ -187,9 +187,9 @@ int main(int argc, char** argv) {
     }
     const Unbalance unbalance = unbalanced_force_ratio(S.model, g);
     std::printf("%.4f %.3e R=%.3e %.3e %.4e %.4e W=%.4e Df=%.4e Dl=%.4e Di=%.4e |", p.time,
-                S.ledger.kinetic, unbalance.ratio, p.speed, p.motion.displacement, p.motion.rotation,
-                S.ledger.external_work, S.ledger.friction_dissipated, S.ledger.local_dissipated,
-                S.ledger.impact_dissipated);
+                S.ledger.kinetic, unbalance.ratio, p.speed, p.motion.displacement,
+                p.motion.rotation, S.ledger.external_work, S.ledger.friction_dissipated,
+                S.ledger.local_dissipated, S.ledger.impact_dissipated);
     for (int j : show_joints) {
       const JointState& st = js[std::size_t(j)];
       const JointResultant& r = jr[std::size_t(j)];
