@@ -125,6 +125,7 @@ double apply_kinetic_damping(Model& model, double kinetic, double dt, KineticDam
   }
   if (!(kinetic < (1.0 - damping.drop) * peak)) return 0.0;
   peak = 0.0;
+  damping.reset = true;
   Nodes& n = model.nodes;
   RigidBodies& r = model.rigid;
   for (std::size_t b = 0; b < model.blocks.size(); ++b) {

@@ -65,6 +65,7 @@ struct LocalDamping {
 struct KineticDamping {
   double drop = 0.0;        // relative fall of K below its peak that triggers a reset; 0: off
   double* peak = nullptr;   // largest K since the last reset [J] (state kept by the caller)
+  bool reset = false;       // out: this step reset the velocities
 };
 
 // Follows K^n = `kinetic` after the central-difference update of step n (of length dt); on a

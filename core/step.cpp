@@ -178,6 +178,7 @@ void advance(Simulation& sim) {
   if (ctx.kinetic_damping > 0.0) {
     KineticDamping kd{ctx.kinetic_damping, &sim.kinetic_peak};
     const double removed = apply_kinetic_damping(model, kinetic, ctx.dt, kd);
+    if (kd.reset) ++sim.kinetic_resets;
     ledger.local_dissipated += removed;
     kinetic -= removed;
   }

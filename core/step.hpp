@@ -68,6 +68,9 @@ struct Simulation {
   // Largest kinetic energy since the last kinetic-damping reset [J] (core/integrate.hpp
   // KineticDamping); 0 while ctx.kinetic_damping is 0.
   double kinetic_peak = 0.0;
+  // Kinetic-damping resets so far: a diagnostic, read by the capacity trials (a trial whose
+  // every step resets stands still, docs/capacity.md "The kinetic damping froze trials at 0.5").
+  long long kinetic_resets = 0;
   // Scratch of the threaded element stage (core/cst.hpp), built at the first large step.
   ElementWorkspace element_work;
 };

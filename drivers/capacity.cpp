@@ -184,6 +184,7 @@ TrialResult run_trial(const SettledState& settled, double lambda, const TrialCri
   r.sim_time = o.time;
   r.steps = o.steps;
   r.energy_balance_error = sim.ledger.balance_error();
+  r.kinetic_resets = sim.kinetic_resets - settled.sim.kinetic_resets;
   r.joints = joint_resultants(sim.model, sim.contact, sim.ctx.dt);
   if (r.collapsed) {
     const double tol = kHingeFraction * settled.l_ref;
@@ -271,15 +272,26 @@ void report(const TrialResult& r, bool quiet, bool resumed) {
   std::fprintf(stderr, "  lambda = %.5f  %-9s (%s, %.3f s simulated, %lld steps, %.2f s wall)%s\n",
                r.lambda, r.collapsed ? "collapsed" : "stable", r.reason.c_str(), r.sim_time,
                r.steps, r.wall_s, resumed ? " [journal]" : "");
+  // A trial whose velocities the kinetic damping reset at most of its steps stood still
+  // whatever the forces on it (docs/capacity.md, "The kinetic damping froze trials at 0.5").
+  if (4 * r.kinetic_resets > r.steps)
+    std::fprintf(stderr,
+                 "  warning: the kinetic damping reset the velocities at %lld of this trial's %lld "
+                 "steps and may have held it still; check it with --dynamic\n",
+                 r.kinetic_resets, r.steps);
 }
 
 nlohmann::json trial_json(const TrialResult& r) {
-  return {{"lambda", r.lambda},     {"collapsed", r.collapsed},
-          {"reason", r.reason},     {"sim_time", r.sim_time},
-          {"steps", r.steps},       {"wall_s", r.wall_s},
+  return {{"lambda", r.lambda},
+          {"collapsed", r.collapsed},
+          {"reason", r.reason},
+          {"sim_time", r.sim_time},
+          {"steps", r.steps},
+          {"wall_s", r.wall_s},
           {"max_displacement", r.max_displacement},
           {"max_rotation", r.max_rotation},
           {"energy_balance_error", r.energy_balance_error},
+          {"kinetic_resets", r.kinetic_resets},
           {"hinges", hinges_record(r.hinges)}};
 }
 
@@ -294,6 +306,7 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   r.max_displacement = j.at("max_displacement");
   r.max_rotation = j.at("max_rotation");
   r.energy_balance_error = j.at("energy_balance_error");
+  r.kinetic_resets = j.value("kinetic_resets", 0LL);  // journals before session 20 have none
   r.hinges = hinges_from_record(j.at("hinges"));
   return r;
 }

@@ -94,6 +94,7 @@ struct TrialResult {
   double max_displacement = 0.0;       // largest block centroid displacement [m]
   double max_rotation = 0.0;           // largest block rotation [rad]
   double energy_balance_error = 0.0;
+  long long kinetic_resets = 0;        // resets of the kinetic damping during the trial
   std::vector<Hinge> hinges;           // joints opened or slid at the end of the trial
   std::vector<double> final_x, final_y;  // node positions at the end (collapsed trials only)
   // Joint resultants at the end of the trial (drivers/thrust.hpp); empty for a trial taken

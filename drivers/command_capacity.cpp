@@ -99,7 +99,8 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
                     {"wall_s", r.wall_s},
                     {"max_displacement", r.max_displacement},
                     {"max_rotation", r.max_rotation},
-                    {"energy_balance_error", r.energy_balance_error}});
+                    {"energy_balance_error", r.energy_balance_error},
+                    {"kinetic_resets", r.kinetic_resets}});
   const nlohmann::json none(nullptr);
   nlohmann::json j = {
           {"lambda_star", res.bracketed ? nlohmann::json(res.lambda_star) : none},
