@@ -48,10 +48,10 @@ namespace voussoir {
 inline constexpr double kRigidStepFraction = 0.4;
 // The quasi-static settle and trials of `capacity` and `sweep` take the same fraction. From
 // session 16 to 19 they took 0.5 (omega dt = 0.9), and that froze trials: the bound omega is
-// per body, the joints couple the bodies into modes up to about 1.3 times faster, and at 0.5
-// such a mode turns within one step (omega dt > 1). The kinetic damping then resets the
-// velocities at every step, and a structure that is not in equilibrium stands still and is
-// called at rest. It happened on church B, and on the buttressed arches at beta 150, whose
+// per body, the joints couple the bodies into modes faster than it (about 1.3 times on the
+// buttressed basket arch), and at 0.5 such a mode turns within one step (omega dt > 1). The
+// kinetic damping then resets the velocities at every second step, and a structure that is
+// not in equilibrium stands still and is called at rest. It happened on church B, and on the buttressed arches at beta 150, whose
 // lambda* it raised by 0.37% (docs/capacity.md, "The kinetic damping froze trials at 0.5").
 // With impact damping (contact.restitution < 1) the dashpot, which acts on the rate of the
 // normal force, must resolve the impact: at the fraction above a drop's rebound misses e^2 by
