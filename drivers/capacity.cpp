@@ -281,6 +281,8 @@ void report(const TrialResult& r, bool quiet, bool resumed) {
                  r.kinetic_resets, r.steps);
 }
 
+}  // namespace
+
 nlohmann::json trial_json(const TrialResult& r) {
   return {{"lambda", r.lambda},
           {"collapsed", r.collapsed},
@@ -310,8 +312,6 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   r.hinges = hinges_from_record(j.at("hinges"));
   return r;
 }
-
-}  // namespace
 
 int unseeded_trial_count(double lambda_star, double lambda_min, double tolerance, int points) {
   constexpr double kFirstGuess = 0.125, kCap = 8.0;

@@ -44,14 +44,15 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
+#include "core/schema.hpp"
 #include "core/step.hpp"
 #include "drivers/kinematics.hpp"
 #include "drivers/thrust.hpp"
 #include "drivers/trial.hpp"
-#include "core/schema.hpp"
 
 namespace voussoir {
 
@@ -137,6 +138,11 @@ std::string settled_fingerprint(const SettledState& settled, const TrialCriteria
 // A set `cancel` stops the trial at its next sample (its result is then meaningless).
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria,
                       bool quiet, const std::atomic<bool>* cancel = nullptr);
+
+// A trial's record: a line of the `--resume` journal, and (without "hinges") an entry of the
+// capacity JSON's "runs"; trial_from_json reads the journal's line back.
+nlohmann::json trial_json(const TrialResult& r);
+TrialResult trial_from_json(const nlohmann::json& j);
 
 // The movie of a trial (`capacity --movie`, docs/thrust.md): the trial run again from the
 // settled state (bit for bit the trial that was classified: same state, load and rules) with

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 #include <nlohmann/json.hpp>
 
@@ -90,17 +91,11 @@ void print_capacity(const CapacityResult& res, const CapacityOptions& opts) {
 // The JSON of one search (SPEC.md section 2).
 nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& opts) {
   nlohmann::json runs = nlohmann::json::array();
-  for (const TrialResult& r : res.trials)
-    runs.push_back({{"lambda", r.lambda},
-                    {"collapsed", r.collapsed},
-                    {"reason", r.reason},
-                    {"sim_time", r.sim_time},
-                    {"steps", r.steps},
-                    {"wall_s", r.wall_s},
-                    {"max_displacement", r.max_displacement},
-                    {"max_rotation", r.max_rotation},
-                    {"energy_balance_error", r.energy_balance_error},
-                    {"kinetic_resets", r.kinetic_resets}});
+  for (const TrialResult& r : res.trials) {
+    nlohmann::json run = trial_json(r);
+    run.erase("hinges");
+    runs.push_back(std::move(run));
+  }
   const nlohmann::json none(nullptr);
   nlohmann::json j = {
           {"lambda_star", res.bracketed ? nlohmann::json(res.lambda_star) : none},
