@@ -52,6 +52,7 @@
 #include "contact/friction.hpp"
 #include "contact/joint_stiffness.hpp"
 #include "contact/narrow_phase.hpp"
+#include "contact/rigid_contact.hpp"
 #include "core/parallel.hpp"
 
 namespace voussoir {
@@ -165,6 +166,10 @@ struct ContactSystem::Impl {
   double thickness = 1.0;  // out-of-plane [m]
   BroadPhase broad;
   bool ready = false;
+  // Rigid blocks (Model::is_rigid at setup): the outline contact of contact/rigid_contact.hpp
+  // does all the work; the triangle-pair machinery below stays idle.
+  bool rigid_mode = false;
+  RigidContact rigid;
 
   // Candidate pairs (triangle ids, sorted) and their friction state.
   std::vector<IndexPair> pairs, next_pairs;
@@ -306,16 +311,28 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
       bm = std::min(bm, h);
     }
   }
+  s.rigid_mode = model.is_rigid();
+  if (s.rigid_mode) s.rigid.setup(model, params, s.penalty, s.block_min_height);
   s.ready = true;
 }
 
 bool ContactSystem::needs_detection(const Nodes& nodes) const {
-  return impl_->ready && impl_->broad.needs_detection(nodes);
+  return impl_->ready && !impl_->rigid_mode && impl_->broad.needs_detection(nodes);
+}
+
+bool ContactSystem::needs_detection(const Model& model) const {
+  if (!impl_->ready) return false;
+  return impl_->rigid_mode ? impl_->rigid.needs_detection(model)
+                           : impl_->broad.needs_detection(model.nodes);
 }
 
 void ContactSystem::detect(const Model& model) {
   Impl& s = *impl_;
   if (!s.ready) return;
+  if (s.rigid_mode) {
+    s.rigid.detect(model);
+    return;
+  }
   s.broad.detect(model.nodes, s.next_pairs);
   carry_friction_history(s.pairs, s.sx, s.sy, s.next_pairs, s.next_sx, s.next_sy);
   if (s.damping) {
@@ -527,6 +544,7 @@ struct StateReader {
 
 std::vector<char> ContactSystem::save_state() const {
   const Impl& s = *impl_;
+  if (s.rigid_mode) return s.rigid.save_state();
   std::vector<char> out;
   put(out, kStateTag);
   put<std::uint8_t>(out, s.ready ? 1 : 0);
@@ -549,6 +567,10 @@ std::vector<char> ContactSystem::save_state() const {
 
 void ContactSystem::restore_state(const Model& model, const std::vector<char>& bytes) {
   Impl& s = *impl_;
+  if (s.rigid_mode) {
+    s.rigid.restore_state(model, bytes);
+    return;
+  }
   StateReader in{bytes};
   const auto tag = in.get<std::uint64_t>();
   if (tag != kStateTag && tag != kStateTag3 && tag != kStateTag2 && tag != kStateTag1)
@@ -868,6 +890,10 @@ void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger) {
     ledger.contact = 0.0;
     return;
   }
+  if (s.rigid_mode) {
+    s.rigid.add_forces(model, dt, ledger);
+    return;
+  }
   // Branch once: with mu = 0 no friction code runs at all; below kSkinPairs no skip.
   const bool mu = s.params.friction > 0.0;
   if (s.skin)
@@ -877,9 +903,19 @@ void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger) {
        : s.accumulate<false, false>(model, dt, ledger);
 }
 
+std::vector<BlockPairForce> ContactSystem::block_pair_forces(const Model& model,
+                                                            double dt) const {
+  if (!impl_->ready || !impl_->rigid_mode) return {};
+  return impl_->rigid.pair_forces(model, dt);
+}
+
+bool ContactSystem::rigid_outlines() const {
+  return impl_->rigid_mode;
+}
+
 std::vector<TouchingPair> ContactSystem::pair_forces(const Model& model, double dt) const {
   std::vector<TouchingPair> out;
-  if (!impl_->ready) return out;
+  if (!impl_->ready || impl_->rigid_mode) return out;
   ContactSystem copy(*this);  // evaluate moves the slip and impact history: on the copy
   if (copy.needs_detection(model.nodes)) copy.detect(model);
   Impl& s = *copy.impl_;
@@ -984,12 +1020,15 @@ void ContactSystem::set_parallel_pairs(std::int64_t min_pairs) {
 }
 
 std::int64_t ContactSystem::candidate_pairs() const {
+  if (impl_->rigid_mode) return impl_->rigid.candidate_pairs();
   return static_cast<std::int64_t>(impl_->pairs.size());
 }
 std::int64_t ContactSystem::active_pairs() const {
+  if (impl_->rigid_mode) return impl_->rigid.active_pairs();
   return impl_->active;
 }
 std::int64_t ContactSystem::detections() const {
+  if (impl_->rigid_mode) return impl_->rigid.detections();
   return impl_->detections;
 }
 const ContactParams& ContactSystem::params() const {
@@ -999,6 +1038,7 @@ double ContactSystem::penalty() const {
   return impl_->penalty;
 }
 double ContactSystem::buffer() const {
+  if (impl_->rigid_mode) return impl_->rigid.buffer();
   return impl_->broad.buffer();
 }
 

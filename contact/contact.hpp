@@ -1,12 +1,14 @@
 #pragma once
 // Contact between blocks: NBS broad phase (contact/broad_phase), Munjiza potential-based
 // penalty force over triangle overlaps (contact/narrow_phase), Coulomb friction on accumulated
-// slip (contact/friction). This header is the one interface core/step.cpp calls.
+// slip (contact/friction); for rigid blocks, the joint law between outlines
+// (contact/rigid_contact). This header is the one interface core/step.cpp calls.
 
 #include <cstdint>
 #include <memory>
 #include <vector>
 
+#include "contact/rigid_contact.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
 
@@ -58,8 +60,12 @@ class ContactSystem {
 
   // Chooses the participating triangles (boundary edge, not both fixed), sizes the grid.
   void setup(const Model& model, const ContactParams& params);
-  // True when some node has moved more than buffer/2 since the last detection.
+  // True when some node has moved more than buffer/2 since the last detection (elastic
+  // blocks; always false for rigid ones, which the Model overload serves).
   bool needs_detection(const Nodes& nodes) const;
+  // The same for any model: for rigid blocks, when some body has moved a point of its outline
+  // by more than buffer/2 (contact/rigid_contact.hpp).
+  bool needs_detection(const Model& model) const;
   // Broad phase: rebuilds the candidate pair list (friction history carried over by key).
   void detect(const Model& model);
   // Narrow phase + friction: adds contact forces into nodes.fx/fy, sets ledger.contact and
@@ -71,6 +77,11 @@ class ContactSystem {
   // when needed, then the narrow phase and friction), so the run's state and its forces are
   // untouched. For reports (drivers/thrust.hpp), never called inside the step.
   std::vector<TouchingPair> pair_forces(const Model& model, double dt) const;
+  // Rigid blocks: the force of every touching block pair (contact/rigid_contact.hpp), the same
+  // way; empty for elastic blocks (pair_forces serves them).
+  std::vector<BlockPairForce> block_pair_forces(const Model& model, double dt) const;
+  // True when the blocks are rigid and touch by their outlines.
+  bool rigid_outlines() const;
 
   // Largest effective contact stiffness per unit nodal mass, for the stable time step:
   // omega_max^2 estimate [1/s2].

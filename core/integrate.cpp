@@ -126,17 +126,14 @@ double apply_kinetic_damping(Model& model, double kinetic, double dt, KineticDam
   if (!(kinetic < (1.0 - damping.drop) * peak)) return 0.0;
   peak = 0.0;
   damping.reset = true;
+  if (model.is_rigid()) {
+    reset_rigid_step(model, dt);
+    return kinetic;
+  }
   Nodes& n = model.nodes;
-  RigidBodies& r = model.rigid;
   for (std::size_t b = 0; b < model.blocks.size(); ++b) {
     const Block& blk = model.blocks[b];
     if (blk.fixed) continue;
-    if (!r.empty()) {
-      if (!(r.mass[b] > 0.0)) continue;
-      set_rigid_state(model, Index(b), r.cx[b] - dt * r.vx[b], r.cy[b] - dt * r.vy[b],
-                      r.theta[b] - dt * r.omega[b], 0.0, 0.0, 0.0);
-      continue;
-    }
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
       n.x[i] -= dt * n.vx[i];
       n.y[i] -= dt * n.vy[i];

@@ -121,14 +121,20 @@ struct Joint {
 };
 
 // Rigid-body state of the blocks made rigid (core/rigid.hpp has the math). Layout: one entry
-// per block (fixed blocks keep zeros and are skipped), rx/ry one per node.
+// per block (fixed blocks keep zeros and are skipped), rx/ry one per node. The step reads and
+// writes only the per-block arrays; the nodes of rigid blocks follow the bodies when a reader
+// asks (sync_rigid_nodes, core/rigid.hpp).
 struct RigidBodies {
   // hot, per block
   std::vector<double> cx, cy, theta;    // centroid [m], rotation [rad] from the reference
   std::vector<double> vx, vy, omega;    // half-step velocity [m/s], angular velocity [rad/s]
+  std::vector<double> fx, fy, torque;   // force [N] and moment about the centroid [N m] of the step
   // cold, per block
   std::vector<double> cx0, cy0;         // reference centroid [m]
   std::vector<double> mass, inertia;    // M [kg], polar moment about the centroid [kg m2]
+  // the mass the body loads act on [kg]: M, also when the quasi-static phases scale `mass`
+  // and `inertia` (core/step.hpp equalize_rigid_inertia)
+  std::vector<double> load_mass;
   // per node: offset from the block's reference centroid [m]
   std::vector<double> rx, ry;
 

@@ -2,6 +2,7 @@
 
 #include "core/rigid.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/integrate.hpp"
@@ -24,8 +25,8 @@ void make_blocks_rigid(Model& model) {
   const Triangles& t = model.tris;
   RigidBodies& r = model.rigid;
   const std::size_t nb = model.blocks.size();
-  for (auto* v :
-       {&r.cx, &r.cy, &r.theta, &r.vx, &r.vy, &r.omega, &r.cx0, &r.cy0, &r.mass, &r.inertia})
+  for (auto* v : {&r.cx, &r.cy, &r.theta, &r.vx, &r.vy, &r.omega, &r.fx, &r.fy, &r.torque, &r.cx0,
+                  &r.cy0, &r.mass, &r.inertia, &r.load_mass})
     v->assign(nb, 0.0);
   r.rx.assign(n.x.size(), 0.0);
   r.ry.assign(n.x.size(), 0.0);
@@ -50,7 +51,7 @@ void make_blocks_rigid(Model& model) {
     }
     r.cx[b] = r.cx0[b] = c.x;
     r.cy[b] = r.cy0[b] = c.y;
-    r.mass[b] = m;
+    r.mass[b] = r.load_mass[b] = m;
     r.inertia[b] = inertia;
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
       r.rx[i] = n.x0[i] - c.x;
@@ -82,23 +83,12 @@ namespace {
 // local damping is on (core/integrate.hpp LocalDamping), books its work into `dissipated`.
 double update_rigid_bodies(Model& model, double dt, double alpha, bool outgoing,
                            double* previous, double& dissipated) {
-  Nodes& n = model.nodes;
   RigidBodies& r = model.rigid;
   double twice_kinetic = 0.0;
-  const double inv_dt = 1.0 / dt;
   const Index nb = static_cast<Index>(model.blocks.size());
   for (Index b = 0; b < nb; ++b) {
-    const Block& blk = model.blocks[b];
-    if (blk.fixed || !(r.mass[b] > 0.0)) continue;
-    const Index begin = blk.first_node, end = blk.first_node + blk.node_count;
-    // Force and moment about the current centroid.
-    const double cx = r.cx[b], cy = r.cy[b];
-    double fx = 0.0, fy = 0.0, torque = 0.0;
-    for (Index i = begin; i < end; ++i) {
-      fx += n.fx[i];
-      fy += n.fy[i];
-      torque += (n.x[i] - cx) * n.fy[i] - (n.y[i] - cy) * n.fx[i];
-    }
+    if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
+    double fx = r.fx[b], fy = r.fy[b], torque = r.torque[b];
     if (previous) {
       double* d_prev = previous + 3 * b;
       const double dx = local_damping_force(alpha, outgoing, fx, r.vx[b]);
@@ -117,23 +107,65 @@ double update_rigid_bodies(Model& model, double dt, double alpha, bool outgoing,
     r.vx[b] = ux;
     r.vy[b] = uy;
     r.omega[b] = w;
-    r.cx[b] = cx + dt * ux;
-    r.cy[b] = cy + dt * uy;
+    r.cx[b] += dt * ux;
+    r.cy[b] += dt * uy;
     r.theta[b] += dt * w;
-    const double cs = std::cos(r.theta[b]), sn = std::sin(r.theta[b]);
-    for (Index i = begin; i < end; ++i) {
-      const double x = r.cx[b] + cs * r.rx[i] - sn * r.ry[i];
-      const double y = r.cy[b] + sn * r.rx[i] + cs * r.ry[i];
-      n.vx[i] = (x - n.x[i]) * inv_dt;
-      n.vy[i] = (y - n.y[i]) * inv_dt;
-      n.x[i] = x;
-      n.y[i] = y;
-    }
   }
   return 0.5 * twice_kinetic;
 }
 
 }  // namespace
+
+void clear_rigid_forces(RigidBodies& r) {
+  std::fill(r.fx.begin(), r.fx.end(), 0.0);
+  std::fill(r.fy.begin(), r.fy.end(), 0.0);
+  std::fill(r.torque.begin(), r.torque.end(), 0.0);
+}
+
+Vec2 add_rigid_body_loads(Model& model, double ax, double ay) {
+  RigidBodies& r = model.rigid;
+  double px = 0.0, py = 0.0;
+  const std::size_t nb = model.blocks.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (model.blocks[b].fixed) continue;
+    const double m = r.load_mass[b];
+    r.fx[b] += m * ax;
+    r.fy[b] += m * ay;
+    px += m * r.vx[b];
+    py += m * r.vy[b];
+  }
+  return {px, py};
+}
+
+void sync_rigid_nodes(Model& model) {
+  if (!model.is_rigid()) return;
+  Nodes& n = model.nodes;
+  const RigidBodies& r = model.rigid;
+  for (std::size_t b = 0; b < model.blocks.size(); ++b) {
+    const Block& blk = model.blocks[b];
+    if (blk.fixed || !(r.mass[b] > 0.0)) continue;
+    const double cs = std::cos(r.theta[b]), sn = std::sin(r.theta[b]);
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+      const double ox = cs * r.rx[i] - sn * r.ry[i], oy = sn * r.rx[i] + cs * r.ry[i];
+      n.x[i] = r.cx[b] + ox;
+      n.y[i] = r.cy[b] + oy;
+      n.vx[i] = r.vx[b] - r.omega[b] * oy;
+      n.vy[i] = r.vy[b] + r.omega[b] * ox;
+      n.fx[i] = n.fy[i] = 0.0;
+    }
+  }
+}
+
+void reset_rigid_step(Model& model, double dt) {
+  RigidBodies& r = model.rigid;
+  for (std::size_t b = 0; b < model.blocks.size(); ++b) {
+    if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
+    r.cx[b] -= dt * r.vx[b];
+    r.cy[b] -= dt * r.vy[b];
+    r.theta[b] -= dt * r.omega[b];
+    r.vx[b] = r.vy[b] = r.omega[b] = 0.0;
+  }
+}
 
 double integrate_rigid_bodies(Model& model, double dt) {
   double unused = 0.0;

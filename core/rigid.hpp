@@ -2,22 +2,21 @@
 // Rigid blocks (SPEC section 1, `material.model = "rigid"`; issue 23).
 //
 // A rigid block is one body: centroid c, rotation theta, velocity v and angular velocity
-// omega. Its triangles and nodes stay: contact is found and evaluated on them exactly as for an
-// elastic block, and every output, hinge report and picture reads the node arrays. What differs
-// is how forces become motion (STYLE.md "Body kinds sit side by side"): the nodal forces of the
-// step (contact, body loads) are summed into a force F and a moment T about c,
-//     F = sum_i f_i,     T = sum_i (x_i - c) x f_i,
-// and the same central-difference scheme as the nodes (core/integrate.hpp) advances the body:
+// omega. Its outline is what touches (contact/rigid_contact.hpp): the contact stage adds its
+// forces and moments to the body's force F and moment T about c, the body loads add M a at c
+// (core/step.hpp), and the same central-difference scheme as the nodes (core/integrate.hpp)
+// advances the body (STYLE.md "Body kinds sit side by side": the kinds differ in how forces
+// become motion):
 //     v^(n+1/2) = v^(n-1/2) + dt F^n / M,        c^(n+1) = c^n + dt v^(n+1/2),
 //     w^(n+1/2) = w^(n-1/2) + dt T^n / I,        theta^(n+1) = theta^n + dt w^(n+1/2).
 // In 2D the rotation has no gyroscopic term, so this is the leapfrog of a system with the
 // constant mass matrix diag(M, M, I): the ledger argument of core/integrate.hpp holds with
 //     K^n = 1/2 (M v^- . v^+ + I w^- w^+).
-// Nodes then follow the body exactly: x_i = c + R(theta) r_i, r_i the node's reference offset
-// from the reference centroid, so a block never changes shape however far it rotates. Node
-// velocities are set to the chord (x_i^(n+1) - x_i^n) / dt: friction reads the relative
-// displacement of the step from them (contact/friction.hpp), the body-load stage the momentum
-// (sum_i m_i v_i = M v, below), outputs and motion measures the speed.
+// The step touches only these per-body arrays. The block's nodes (its minimal mesh,
+// mesh/minimal.hpp) are what outputs, pictures, hinges and motion measures read; they follow
+// the body when a reader asks: sync_rigid_nodes sets x_i = c + R(theta) r_i (r_i the node's
+// reference offset from the reference centroid, so a block never changes shape however far
+// it rotates) and v_i = v + w x (x_i - c), the rigid velocity field of the half step.
 //
 // Mass and inertia come from the block's triangles: M = rho t_z A, c the area centroid, and
 // I = rho t_z sum over triangles of A/6 (|p0|^2 + |p1|^2 + |p2|^2 + p0.p1 + p1.p2 + p2.p0),
@@ -62,13 +61,29 @@ inline constexpr double kRigidDampedStepFraction = 0.2;
 // reference ones, as finalize_model leaves them). Fixed blocks stay fixed.
 void make_blocks_rigid(Model& model);
 
-// Central-difference update of the rigid blocks from the nodal forces of the step; moves their
-// nodes and sets the node velocities to the chord velocities. Returns K^n [J] (above).
+// Sets the force and moment of every body to zero (the step's stage 2 for rigid blocks).
+void clear_rigid_forces(RigidBodies& bodies);
+
+// Adds the body loads M (ax, ay) at each free body's centroid (M: RigidBodies::load_mass) and
+// returns the momentum sum M v^(n-1/2) before the update, for the external work (core/loads.hpp).
+Vec2 add_rigid_body_loads(Model& model, double ax, double ay);
+
+// Central-difference update of the rigid blocks from their force and moment of the step
+// (RigidBodies::fx, fy, torque). Returns K^n [J] (above). The nodes are not moved.
 double integrate_rigid_bodies(Model& model, double dt);
 
 // Same with Cundall's local damping on each body's x, y and rotation (core/integrate.hpp
 // LocalDamping; damping.alpha > 0): books damping.dissipated.
 double integrate_rigid_bodies(Model& model, double dt, LocalDamping& damping);
+
+// Puts the nodes of the rigid blocks where their bodies are, with the bodies' velocity field
+// (above); their force accumulators read zero (rigid blocks' forces are per body). Call before
+// reading node positions or velocities of a rigid model; nothing for an elastic one.
+void sync_rigid_nodes(Model& model);
+
+// The kinetic damping's reset for rigid blocks (core/integrate.hpp KineticDamping): every body
+// back to c^n = c^(n+1) - dt v^(n+1/2) (and theta likewise) at rest.
+void reset_rigid_step(Model& model, double dt);
 
 // Places rigid block b at centroid (cx, cy) and rotation theta with velocity (vx, vy, omega),
 // its nodes and their velocities with it (initial states of tests and studies).

@@ -127,16 +127,20 @@ void advance(Simulation& sim) {
   StageClock clock(timers.enabled);
   const bool first = sim.step == 0;
 
-  // 1. broad phase, only when some node moved more than the buffer allows
-  if (ctx.contact_on && sim.contact.needs_detection(model.nodes)) sim.contact.detect(model);
+  // 1. broad phase, only when some node (rigid blocks: some outline point) moved more than the
+  //    buffer allows
+  const bool rigid = model.is_rigid();
+  if (ctx.contact_on && sim.contact.needs_detection(model)) sim.contact.detect(model);
   clock.stamp(timers.broad);
 
-  // 2. clear forces
-  clear_forces(model.nodes);
+  // 2. clear forces (of the nodes, or of the rigid bodies)
+  if (rigid)
+    clear_rigid_forces(model.rigid);
+  else
+    clear_forces(model.nodes);
 
   // 3. element forces (CST + Munjiza damping at the half-step velocities); none for rigid
   //    blocks
-  const bool rigid = model.is_rigid();
   const CstLaw law = law_of(ctx);
   if (rigid) {
     sim.viscous_piola.clear();
@@ -160,10 +164,11 @@ void advance(Simulation& sim) {
   clock.stamp(timers.contact);
 
   // 5. body loads; the momentum before the update gives the exact external work
-  const Vec2 momentum = add_body_loads(model, ctx.body_ax, ctx.body_ay);
+  const Vec2 momentum = rigid ? add_rigid_body_loads(model, ctx.body_ax, ctx.body_ay)
+                              : add_body_loads(model, ctx.body_ax, ctx.body_ay);
   clock.stamp(timers.loads);
 
-  // 6. central difference: v then x (of the nodes, or of the rigid bodies and their nodes)
+  // 6. central difference: v then x (of the nodes, or of the rigid bodies)
   double kinetic = 0.0;
   if (ctx.local_damping > 0.0) {
     LocalDamping damping{ctx.local_damping, ctx.local_damping_outgoing,

@@ -2,6 +2,8 @@
 
 #include "drivers/pulse.hpp"
 
+#include "core/rigid.hpp"
+
 #include "core/fnv.hpp"
 
 #include <omp.h>
@@ -202,9 +204,11 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, duration, false));
   spec.rules.push_back(std::make_unique<TrendRule>(d_fall, crit.fall_rotation, duration, duration,
                                                    duration + crit.free_time));
-  spec.on_step = [&](const Simulation& s, const StepInfo&) {
+  spec.on_step = [&](Simulation& s, const StepInfo&) {
     r.max_kinetic_energy = std::max(r.max_kinetic_energy, s.ledger.kinetic);
-    if ((s.step - step0) % rec_every == 0) record(s);
+    if ((s.step - step0) % rec_every != 0) return;
+    sync_rigid_nodes(s.model);
+    record(s);
   };
   spec.on_sample = [&](const Simulation& s, const Probe&) {
     const EnergyLedger& l = s.ledger;

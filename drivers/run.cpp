@@ -1,5 +1,7 @@
 #include "drivers/run.hpp"
 
+#include "core/rigid.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -67,11 +69,14 @@ LoopStats run_loop(Simulation& sim, const LoopOptions& opts,
   // Checkpoints: off the sample grid before that step's sample (the end-of-run sample that a
   // longer run would not take), on the grid after it.
   bool checkpoint_after_sample = false;
-  spec.on_step = [&](const Simulation& s, const StepInfo& at) {
+  spec.on_step = [&](Simulation& s, const StepInfo& at) {
     stats.max_active_pairs = std::max(stats.max_active_pairs, s.contact.active_pairs());
     const bool due = ckpt_every > 0 && ((s.step % ckpt_every == 0 && !at.last) ||
                                         (at.last && opts.checkpoint_at_end));
-    if (due && !at.sample) write_checkpoint(s);
+    if (due && !at.sample) {
+      sync_rigid_nodes(s.model);
+      write_checkpoint(s);
+    }
     checkpoint_after_sample = due && at.sample;
   };
   spec.on_sample = [&](const Simulation& s, const Probe&) {

@@ -27,10 +27,11 @@ Vec2 reference_centroid(const Model& model, Index e) {
           (n.y0[t.n0[e]] + n.y0[t.n1[e]] + n.y0[t.n2[e]]) / 3.0};
 }
 
-}  // namespace
-
-std::vector<JointResultant> joint_resultants(const Model& model,
-                                             const std::vector<TouchingPair>& forces) {
+// Resultants from the triangle pairs' nodal forces (elastic blocks) or from the block pairs'
+// forces (rigid blocks): one of the two lists is empty.
+std::vector<JointResultant> resultants_of(const Model& model,
+                                          const std::vector<TouchingPair>& forces,
+                                          const std::vector<BlockPairForce>& block_forces) {
   const std::size_t nj = model.joints.size();
   // The block summed per joint (B, or A when B is fixed), its force and moment about O.
   std::vector<Index> side(nj);
@@ -74,6 +75,17 @@ std::vector<JointResultant> joint_resultants(const Model& model,
     }
     touched[j] = 1;
   }
+  // A rigid block pair: its force on the summed block and the moment about O; several joints
+  // between the same two blocks take it at the first.
+  for (const BlockPairForce& f : block_forces) {
+    const auto it = by_blocks.find({std::min(f.block_a, f.block_b), std::max(f.block_a, f.block_b)});
+    if (it == by_blocks.end()) continue;
+    const int j = it->second.front();
+    const double sign = f.block_b == side[j] ? 1.0 : -1.0;  // forces on a are minus those on b
+    force[j] = force[j] + sign * f.force;
+    moment[j] += sign * (f.moment + cross(f.origin - mid[j], f.force));
+    touched[j] = 1;
+  }
 
   std::vector<JointResultant> out(nj);
   for (std::size_t j = 0; j < nj; ++j) {
@@ -109,8 +121,16 @@ std::vector<JointResultant> joint_resultants(const Model& model,
   return out;
 }
 
+}  // namespace
+
+std::vector<JointResultant> joint_resultants(const Model& model,
+                                             const std::vector<TouchingPair>& forces) {
+  return resultants_of(model, forces, {});
+}
+
 std::vector<JointResultant> joint_resultants(const Model& model, const ContactSystem& contact,
                                              double dt) {
+  if (contact.rigid_outlines()) return resultants_of(model, {}, contact.block_pair_forces(model, dt));
   return joint_resultants(model, contact.pair_forces(model, dt));
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/rigid.hpp"
 #include "drivers/setup.hpp"
 
 namespace voussoir {
@@ -157,7 +158,12 @@ std::optional<Verdict> CollapseRule::check(const Probe& p) {
 
 std::optional<Verdict> RestRule::check(const Probe& p) {
   if (p.time < from_) return std::nullopt;
-  const bool still = detector_.update(p.time, p.speed, p.sim.ledger.kinetic);
+  // Kinetic energy below a millionth of the free mass's at the rest speed counts as none: at
+  // rest a structure's kinetic energy is round-off of its contact forces, 0 after a kinetic-
+  // damping reset and 1e-22 J the next step, which would read as growing.
+  if (kinetic_floor_ < 0.0) kinetic_floor_ = 0.5 * free_mass(p.sim.model) * 1e-6 * v_rest_ * v_rest_;
+  const double kinetic = p.sim.ledger.kinetic > kinetic_floor_ ? p.sim.ledger.kinetic : 0.0;
+  const bool still = detector_.update(p.time, p.speed, kinetic);
   // A refused rest is retried at the next sample: the speed window stays open.
   if (creep_) creep_->add(p.time, std::max(p.motion.displacement / d_, p.motion.rotation / rot_));
   if (still && !(creep_ && creep_->creeping())) return Verdict{false, "rest"};
@@ -232,6 +238,7 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
     p.speed = max_free_speed(sim.model.nodes);
     return p;
   };
+  sync_rigid_nodes(sim.model);
   if (spec.sample_at_start && spec.on_sample && !spec.on_sample(sim, probe_now())) {
     out.steps = 0;
     out.wall_s = seconds_since(wall0);
@@ -245,10 +252,12 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
     StepInfo info;
     info.last = spec.end_step >= 0 && sim.step == spec.end_step;
     info.sample = (sim.step - origin) % every == 0;
+    const bool ends = info.last || !(sim.ctx.time - t_start < spec.end_time);
+    // Rigid blocks' nodes follow their bodies where something reads them: samples and ends.
+    if (info.sample || ends) sync_rigid_nodes(sim.model);
     if (spec.on_step) spec.on_step(sim, info);
     if (!info.sample && !(info.last && spec.sample_last)) {
       // The last step of a run that ends off the sample grid is still guarded.
-      const bool ends = info.last || !(sim.ctx.time - t_start < spec.end_time);
       if (ends)
         for (auto& g : guards) g->check(clock_probe());
       continue;
@@ -275,6 +284,7 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
     }
     if (!go_on || (out.decided && p.time >= spec.min_time)) break;
   }
+  sync_rigid_nodes(sim.model);
   out.time = sim.ctx.time - t_start;
   out.steps = sim.step - step_start;
   out.wall_s = seconds_since(wall0);

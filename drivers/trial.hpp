@@ -133,7 +133,7 @@ class RestRule : public StopRule {
  public:
   // require_decay: RestDetector's growth check (off for the pulses: speed alone).
   RestRule(double v_rest, double hold, double from, bool require_decay = true)
-      : detector_(v_rest, hold, require_decay), hold_(hold), from_(from) {}
+      : detector_(v_rest, hold, require_decay), v_rest_(v_rest), hold_(hold), from_(from) {}
   // Also refuse a creep (CreepDetector, drivers/motion.hpp): rest needs the motion measure
   // max(d / d_scale, rot / rot_scale) to have grown by at most `tolerance` over the hold
   // window. Needs RunSpec::track_motion.
@@ -158,6 +158,8 @@ class RestRule : public StopRule {
   bool going_back(const Probe& p);
 
   RestDetector detector_;
+  double v_rest_;
+  double kinetic_floor_ = -1.0;  // [J], set at the first sample (check)
   double hold_, from_;
   double d_ = 1.0, rot_ = 1.0;
   std::optional<CreepDetector> creep_;
@@ -209,7 +211,10 @@ struct RunSpec {
   double min_time = 0.0;                   // a decided run goes on to this run time [s]
   bool track_motion = false;               // compute Probe::motion at samples
   std::vector<BlockMotion> motion_base;    // reference of Probe::motion; empty: the start
-  std::function<void(const Simulation&, const StepInfo&)> on_step;
+  // Called after every step. The nodes of rigid blocks are in step with their bodies only at
+  // samples and at the end (the step moves bodies, not nodes): a hook that reads them at other
+  // steps calls sync_rigid_nodes (core/rigid.hpp) first.
+  std::function<void(Simulation&, const StepInfo&)> on_step;
   std::function<bool(const Simulation&, const Probe&)> on_sample;  // false: stop the run
   // Progress on stderr every progress_period of wall time unless quiet.
   bool quiet = true;

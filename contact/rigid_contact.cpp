@@ -1,0 +1,638 @@
+// Contact of rigid blocks between outlines (the law and its integrals in rigid_contact.hpp).
+
+#include "contact/rigid_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+#include "contact/contact.hpp"
+#include "contact/friction.hpp"
+#include "contact/joint_stiffness.hpp"
+
+namespace voussoir {
+
+namespace {
+
+// Labels of a clipped vertex: the boundary its outgoing edge lies on.
+constexpr std::uint8_t kOnP = 0, kOnQ = 1;
+// Largest vertex count of a clipped polygon: P's vertices plus two per line of Q.
+constexpr int kMaxClipped = 3 * kMaxPieceVertices + 4;
+
+// Clips the convex polygon (in, n) by the inner side of a line of Q (d: each vertex's signed
+// distance to it times the side's length, >= 0 inside); returns the vertex count of `out`
+// (Sutherland-Hodgman with the edge labels of rigid_contact.hpp).
+int clip_by_line(const Vec2* in, const std::uint8_t* in_on, int n, const double* d, Vec2* out,
+                 std::uint8_t* out_on) {
+  int m = 0;
+  int prev = n - 1;
+  for (int k = 0; k < n; ++k) {
+    const bool prev_in = d[prev] >= 0.0, cur_in = d[k] >= 0.0;
+    if (cur_in != prev_in) {
+      const double t = d[prev] / (d[prev] - d[k]);
+      out[m] = {in[prev].x + t * (in[k].x - in[prev].x), in[prev].y + t * (in[k].y - in[prev].y)};
+      // Entering: the edge from here runs on along P's (or the earlier line's) edge; leaving:
+      // along this line of Q.
+      out_on[m++] = cur_in ? in_on[prev] : kOnQ;
+    }
+    if (cur_in) {
+      out[m] = in[k];
+      out_on[m++] = in_on[k];
+    }
+    prev = k;
+  }
+  return m;
+}
+
+// Is the counter-clockwise polygon convex (collinear vertices allowed)?
+bool is_convex(const std::vector<Vec2>& v) {
+  const std::size_t n = v.size();
+  if (n < 3) return false;
+  double scale = 0.0;
+  for (std::size_t k = 0; k < n; ++k) scale = std::max(scale, distance(v[k], v[(k + 1) % n]));
+  const double tol = -1e-12 * scale * scale;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 e0 = v[(k + 1) % n] - v[k], e1 = v[(k + 2) % n] - v[(k + 1) % n];
+    if (cross(e0, e1) < tol) return false;
+  }
+  return true;
+}
+
+// Convex pieces of block b as lists of node ids: its triangles merged across shared edges while
+// the union stays convex and within kMaxPieceVertices.
+std::vector<std::vector<Index>> merged_triangles(const Model& model, Index b) {
+  const Triangles& t = model.tris;
+  const Nodes& n = model.nodes;
+  const Block& blk = model.blocks[std::size_t(b)];
+  std::vector<std::vector<Index>> pieces;
+  for (Index e = blk.first_tri; e < blk.first_tri + blk.tri_count; ++e)
+    pieces.push_back({t.n0[e], t.n1[e], t.n2[e]});
+  auto points = [&](const std::vector<Index>& ids) {
+    std::vector<Vec2> v;
+    for (Index i : ids) v.push_back({n.x0[i], n.y0[i]});
+    return v;
+  };
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t i = 0; i < pieces.size() && !merged; ++i)
+      for (std::size_t j = i + 1; j < pieces.size() && !merged; ++j) {
+        const std::vector<Index>& pi = pieces[i];
+        const std::vector<Index>& pj = pieces[j];
+        for (std::size_t ki = 0; ki < pi.size() && !merged; ++ki) {
+          const Index u = pi[ki], v = pi[(ki + 1) % pi.size()];
+          for (std::size_t kj = 0; kj < pj.size(); ++kj) {
+            if (pj[kj] != v || pj[(kj + 1) % pj.size()] != u) continue;
+            // i from v round to u, then j's vertices strictly between u and v.
+            std::vector<Index> joined;
+            for (std::size_t s = 0; s < pi.size(); ++s) joined.push_back(pi[(ki + 1 + s) % pi.size()]);
+            for (std::size_t s = 2; s < pj.size(); ++s) joined.push_back(pj[(kj + s) % pj.size()]);
+            if (int(joined.size()) <= kMaxPieceVertices && is_convex(points(joined))) {
+              pieces[i] = joined;
+              pieces.erase(pieces.begin() + std::ptrdiff_t(j));
+              merged = true;
+            }
+            break;
+          }
+        }
+      }
+  }
+  return pieces;
+}
+
+}  // namespace
+
+bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out) {
+  Vec2 buf[2][kMaxClipped];
+  std::uint8_t on[2][kMaxClipped];
+  double d[kMaxClipped];
+  // Coordinates relative to P's first vertex: the sliver's sums then cancel less.
+  const Vec2 o = p[0];
+  int n = np, cur = 0;
+  for (int k = 0; k < np; ++k) buf[0][k] = p[k] - o, on[0][k] = kOnP;
+  for (int j = 0; j < nq; ++j) {
+    const Vec2 a = q[j] - o, b = q[(j + 1) % nq] - o;
+    const Vec2 e = b - a;
+    bool all_in = true, all_out = true;
+    for (int k = 0; k < n; ++k) {
+      d[k] = cross(e, buf[cur][k] - a);
+      all_in = all_in && d[k] >= 0.0;
+      all_out = all_out && d[k] < 0.0;
+    }
+    if (all_out) return false;
+    if (all_in) continue;
+    n = clip_by_line(buf[cur], on[cur], n, d, buf[1 - cur], on[1 - cur]);
+    cur = 1 - cur;
+    if (n < 3) return false;
+  }
+  const Vec2* v = buf[cur];
+  const std::uint8_t* lab = on[cur];
+  // Area, first moment and P's outward normals (Green's theorem).
+  double a2 = 0.0, mx = 0.0, my = 0.0, npx = 0.0, npy = 0.0, nqx = 0.0, nqy = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const Vec2 v0 = v[k], v1 = v[k + 1 < n ? k + 1 : 0];
+    const double c = cross(v0, v1);
+    a2 += c;
+    mx += (v0.x + v1.x) * c;
+    my += (v0.y + v1.y) * c;
+    if (lab[k] == kOnP) {
+      npx += v1.y - v0.y, npy -= v1.x - v0.x;
+    } else {
+      nqx += v1.y - v0.y, nqy -= v1.x - v0.x;
+    }
+  }
+  if (!(a2 > 0.0)) return false;
+  const double nx = 0.5 * (npx - nqx), ny = 0.5 * (npy - nqy);
+  const double chord = std::hypot(nx, ny);
+  if (!(chord > 0.0)) return false;
+  out.area = 0.5 * a2;
+  out.centroid = {o.x + mx / (3.0 * a2), o.y + my / (3.0 * a2)};
+  out.normal = {nx / chord, ny / chord};
+  out.chord = chord;
+  // integral d(s)^2 ds: s along t = (-n_y, n_x), h along n; between consecutive abscissae the
+  // width is linear (rigid_contact.hpp).
+  const Vec2 tn{-out.normal.y, out.normal.x};
+  double s[kMaxClipped], h[kMaxClipped], sorted[kMaxClipped];
+  for (int k = 0; k < n; ++k) {
+    s[k] = dot(tn, v[k]);
+    h[k] = dot(out.normal, v[k]);
+    sorted[k] = s[k];
+  }
+  std::sort(sorted, sorted + n);
+  double integral = 0.0;
+  for (int j = 0; j + 1 < n; ++j) {
+    const double s0 = sorted[j], s1 = sorted[j + 1];
+    if (!(s1 > s0)) continue;
+    const double sm = 0.5 * (s0 + s1);
+    // The two edges spanning the interval: their heights at s0 and s1.
+    double lo0 = 0.0, lo1 = 0.0, hi0 = 0.0, hi1 = 0.0;
+    int found = 0;
+    for (int k = 0; k < n && found < 2; ++k) {
+      const int k1 = k + 1 < n ? k + 1 : 0;
+      const double sa = s[k], sb = s[k1];
+      if (!((sa <= sm && sm <= sb) || (sb <= sm && sm <= sa)) || sa == sb) continue;
+      const double slope = (h[k1] - h[k]) / (sb - sa);
+      const double e0 = h[k] + slope * (s0 - sa), e1 = h[k] + slope * (s1 - sa);
+      if (found == 0) {
+        lo0 = e0, lo1 = e1;
+      } else {
+        hi0 = e0, hi1 = e1;
+      }
+      ++found;
+    }
+    if (found < 2) continue;
+    const double w0 = std::abs(hi0 - lo0), w1 = std::abs(hi1 - lo1);
+    integral += (s1 - s0) * (w0 * w0 + w0 * w1 + w1 * w1) / 3.0;
+  }
+  out.depth_sq = integral;
+  return true;
+}
+
+void RigidContact::setup(const Model& model, const ContactParams& params, double penalty,
+                         const std::vector<double>& block_min_height) {
+  const RigidBodies& r = model.rigid;
+  mu_ = params.friction;
+  thickness_ = model.out_of_plane;
+  damping_ = params.restitution < 1.0;
+  zeta_ = restitution_damping_ratio(params.restitution);
+  kn_given_ = params.normal_stiffness;
+  ks_given_ = params.shear_stiffness;
+  young_ = params.joint_young;
+  penalty_ = penalty;
+  min_height_ = block_min_height;
+
+  // Convex pieces (offsets from the reference centroid for free blocks).
+  const std::size_t nb = model.blocks.size();
+  piece_first_.assign(1, 0);
+  block_piece_.assign(1, 0);
+  ref_x_.clear();
+  ref_y_.clear();
+  radius_.assign(nb, 0.0);
+  longest_side_.assign(nb, 0.0);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Block& blk = model.blocks[b];
+    const bool moves = !blk.fixed && r.mass.size() == nb && r.mass[b] > 0.0;
+    const Vec2 origin = moves ? Vec2{r.cx0[b], r.cy0[b]} : Vec2{};
+    const std::vector<Vec2>& poly = blk.polygon;
+    for (std::size_t k = 0; k < poly.size(); ++k)
+      longest_side_[b] = std::max(longest_side_[b], distance(poly[k], poly[(k + 1) % poly.size()]));
+    std::vector<std::vector<Vec2>> pieces;
+    if (is_convex(poly) && int(poly.size()) <= kMaxPieceVertices) {
+      pieces.push_back(poly);
+    } else {
+      for (const std::vector<Index>& ids : merged_triangles(model, Index(b))) {
+        std::vector<Vec2> v;
+        for (Index i : ids) v.push_back({model.nodes.x0[i], model.nodes.y0[i]});
+        pieces.push_back(v);
+      }
+    }
+    for (const std::vector<Vec2>& piece : pieces) {
+      for (const Vec2& v : piece) {
+        ref_x_.push_back(v.x - origin.x);
+        ref_y_.push_back(v.y - origin.y);
+      }
+      piece_first_.push_back(Index(ref_x_.size()));
+    }
+    block_piece_.push_back(Index(piece_first_.size() - 1));
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i)
+      radius_[b] = std::max(radius_[b], std::hypot(model.nodes.x0[i] - origin.x,
+                                                   model.nodes.y0[i] - origin.y));
+  }
+  const std::size_t pieces = piece_first_.size() - 1;
+  world_.resize(ref_x_.size());
+  box_lo_x_.assign(pieces, 0.0), box_lo_y_.assign(pieces, 0.0);
+  box_hi_x_.assign(pieces, 0.0), box_hi_y_.assign(pieces, 0.0);
+  // Fixed blocks' pieces stay where they are.
+  for (std::size_t b = 0; b < nb; ++b) {
+    for (Index k = block_piece_[b]; k < block_piece_[b + 1]; ++k) {
+      double lx = std::numeric_limits<double>::infinity(), ly = lx, hx = -lx, hy = -lx;
+      for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v) {
+        world_[v] = {ref_x_[v], ref_y_[v]};
+        lx = std::min(lx, ref_x_[v]), hx = std::max(hx, ref_x_[v]);
+        ly = std::min(ly, ref_y_[v]), hy = std::max(hy, ref_y_[v]);
+      }
+      box_lo_x_[k] = lx, box_lo_y_[k] = ly, box_hi_x_[k] = hx, box_hi_y_[k] = hy;
+    }
+  }
+
+  // Joints per block pair: summed length, the direction of the longest.
+  joints_.clear();
+  for (const Joint& j : model.joints) {
+    const double len = distance(j.a, j.b);
+    if (!(len > 0.0)) continue;
+    JointInfo info{std::min(j.block_a, j.block_b), std::max(j.block_a, j.block_b), len,
+                   (1.0 / len) * (j.b - j.a)};
+    joints_.push_back(info);
+  }
+  std::sort(joints_.begin(), joints_.end(), [](const JointInfo& x, const JointInfo& y) {
+    return x.a != y.a ? x.a < y.a : (x.b != y.b ? x.b < y.b : x.length > y.length);
+  });
+  std::vector<JointInfo> summed;
+  for (const JointInfo& j : joints_) {
+    if (!summed.empty() && summed.back().a == j.a && summed.back().b == j.b)
+      summed.back().length += j.length;
+    else
+      summed.push_back(j);
+  }
+  joints_ = summed;
+
+  // Broad phase on the outline triangles.
+  scratch_ = model.nodes;
+  const Participants parts = select_participants(model);
+  const double buffer = params.buffer > 0.0 ? params.buffer : default_buffer(model, parts);
+  broad_.setup(model, buffer);
+  detected_ = false;
+  pair_a_.clear(), pair_b_.clear(), kn_t_.clear(), kt_.clear(), beta_.clear();
+  slip_x_.clear(), slip_y_.clear(), last_w_.clear();
+  damp_now_.assign(3 * nb, 0.0), damp_prev_ = damp_now_;
+  fric_now_ = damp_now_, fric_prev_ = damp_now_;
+  stored_prev_ = 0.0;
+  active_ = detections_ = 0;
+}
+
+bool RigidContact::needs_detection(const Model& model) const {
+  if (!detected_) return true;
+  const RigidBodies& r = model.rigid;
+  const double half = 0.5 * broad_.buffer();
+  const std::size_t nb = model.blocks.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
+    const double moved = std::hypot(r.cx[b] - ref_cx_[b], r.cy[b] - ref_cy_[b]) +
+                         radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
+    if (moved > half) return true;
+  }
+  return false;
+}
+
+void RigidContact::detect(const Model& model) {
+  const RigidBodies& r = model.rigid;
+  const std::size_t nb = model.blocks.size();
+  // Node positions from the bodies (the outline triangles' corners).
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Block& blk = model.blocks[b];
+    if (blk.fixed || !(r.mass[b] > 0.0)) continue;
+    const double c = std::cos(r.theta[b]), s = std::sin(r.theta[b]);
+    for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+      scratch_.x[i] = r.cx[b] + c * r.rx[i] - s * r.ry[i];
+      scratch_.y[i] = r.cy[b] + s * r.rx[i] + c * r.ry[i];
+    }
+  }
+  broad_.detect(scratch_, tri_pairs_);
+  std::vector<std::pair<Index, Index>> next;
+  next.reserve(tri_pairs_.size());
+  const Triangles& t = model.tris;
+  for (const IndexPair& tp : tri_pairs_) {
+    const Index a = t.block[tp.a], b = t.block[tp.b];
+    next.push_back({std::min(a, b), std::max(a, b)});
+  }
+  std::sort(next.begin(), next.end());
+  next.erase(std::unique(next.begin(), next.end()), next.end());
+  // Carry the friction slip and the dashpot's last wrench by the block pair.
+  const std::size_t np = next.size();
+  std::vector<Index> na(np), nbk(np);
+  std::vector<double> sx(np, 0.0), sy(np, 0.0), w(4 * np, 0.0);
+  std::size_t o = 0;
+  for (std::size_t p = 0; p < np; ++p) {
+    na[p] = next[p].first, nbk[p] = next[p].second;
+    while (o < pair_a_.size() &&
+           (pair_a_[o] < na[p] || (pair_a_[o] == na[p] && pair_b_[o] < nbk[p])))
+      ++o;
+    if (o < pair_a_.size() && pair_a_[o] == na[p] && pair_b_[o] == nbk[p]) {
+      sx[p] = slip_x_[o], sy[p] = slip_y_[o];
+      for (int k = 0; k < 4; ++k) w[4 * p + k] = last_w_[4 * o + k];
+    }
+  }
+  pair_a_.swap(na), pair_b_.swap(nbk);
+  slip_x_.swap(sx), slip_y_.swap(sy), last_w_.swap(w);
+  pair_constants(model);
+  ref_cx_ = r.cx, ref_cy_ = r.cy, ref_theta_ = r.theta;
+  detected_ = true;
+  ++detections_;
+}
+
+// kn t_z, k_t and beta of each candidate pair, from the reference geometry only (so a restart's
+// detection gives the same values).
+void RigidContact::pair_constants(const Model& model) {
+  const std::size_t np = pair_a_.size();
+  kn_t_.resize(np), kt_.resize(np), beta_.resize(np);
+  for (std::size_t p = 0; p < np; ++p) {
+    const Index a = pair_a_[p], b = pair_b_[p];
+    const Block& ba = model.blocks[std::size_t(a)];
+    const Block& bb = model.blocks[std::size_t(b)];
+    const JointInfo key{a, b, 0.0, {}};
+    const auto it = std::lower_bound(
+        joints_.begin(), joints_.end(), key,
+        [](const JointInfo& x, const JointInfo& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+    const bool joint = it != joints_.end() && it->a == a && it->b == b;
+    const double length =
+        joint ? it->length : std::min(longest_side_[std::size_t(a)], longest_side_[std::size_t(b)]);
+    // The free block first, as the joint mapping of joint_stiffness.hpp takes it.
+    const Block& first = ba.fixed ? bb : ba;
+    const Block& second = ba.fixed ? ba : bb;
+    double kn = kn_given_;
+    if (!(kn > 0.0) && young_ > 0.0) {
+      kn = joint ? default_joint_stiffness(young_, first, &second, Vec2{it->tangent.y, -it->tangent.x})
+                 : kRigidJointFactor * young_ / length;
+    } else if (!(kn > 0.0)) {
+      kn = penalty_ * (3.0 / min_height_[std::size_t(a)] + 3.0 / min_height_[std::size_t(b)]);
+    }
+    const double ks = ks_given_ > 0.0 ? ks_given_ : kTangentialStiffnessRatio * kn;
+    kn_t_[p] = kn * thickness_;
+    kt_[p] = ks * thickness_ * length;
+    beta_[p] = 0.0;
+    if (damping_) {
+      double omega = 0.0;
+      if (joint) {
+        omega = joint_frequency(kn_t_[p], first, first.mass, &second, second.mass, it->tangent);
+      } else {
+        const double m_eff = ba.fixed   ? bb.mass
+                             : bb.fixed ? ba.mass
+                                        : ba.mass * bb.mass / (ba.mass + bb.mass);
+        omega = m_eff > 0.0 ? std::sqrt(kn_t_[p] * length / m_eff) : 0.0;
+      }
+      beta_[p] = omega > 0.0 ? 2.0 * zeta_ / omega : 0.0;
+    }
+  }
+}
+
+void RigidContact::world_pieces(const Model& model) {
+  const RigidBodies& r = model.rigid;
+  const std::size_t nb = model.blocks.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
+    const double c = std::cos(r.theta[b]), s = std::sin(r.theta[b]);
+    const double cx = r.cx[b], cy = r.cy[b];
+    for (Index k = block_piece_[b]; k < block_piece_[b + 1]; ++k) {
+      double lx = std::numeric_limits<double>::infinity(), ly = lx, hx = -lx, hy = -lx;
+      for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v) {
+        const double x = cx + c * ref_x_[v] - s * ref_y_[v];
+        const double y = cy + s * ref_x_[v] + c * ref_y_[v];
+        world_[v] = {x, y};
+        lx = std::min(lx, x), hx = std::max(hx, x);
+        ly = std::min(ly, y), hy = std::max(hy, y);
+      }
+      box_lo_x_[k] = lx, box_lo_y_[k] = ly, box_hi_x_[k] = hx, box_hi_y_[k] = hy;
+    }
+  }
+}
+
+// Pair p at the current configuration: false when its blocks do not overlap (its history is
+// then dropped).
+bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, PairOut& out) {
+  const RigidBodies& r = model.rigid;
+  const Index a = pair_a_[p], b = pair_b_[p];
+  double area = 0.0, energy2 = 0.0, gx = 0.0, gy = 0.0;
+  Vec2 force;
+  double mb = 0.0, ma = 0.0;
+  const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
+  for (Index i = block_piece_[a]; i < block_piece_[a + 1]; ++i)
+    for (Index j = block_piece_[b]; j < block_piece_[b + 1]; ++j) {
+      if (box_lo_x_[i] > box_hi_x_[j] || box_lo_x_[j] > box_hi_x_[i] ||
+          box_lo_y_[i] > box_hi_y_[j] || box_lo_y_[j] > box_hi_y_[i])
+        continue;
+      ConvexOverlap o;
+      if (!convex_overlap(&world_[piece_first_[i]], piece_first_[i + 1] - piece_first_[i],
+                          &world_[piece_first_[j]], piece_first_[j + 1] - piece_first_[j], o))
+        continue;
+      const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b
+      force = force + f;
+      mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
+      ma -= (o.centroid.x - ca_x) * f.y - (o.centroid.y - ca_y) * f.x;
+      area += o.area;
+      gx += o.area * o.centroid.x, gy += o.area * o.centroid.y;
+      energy2 += o.depth_sq;
+    }
+  double* w = &last_w_[4 * p];
+  if (!(area > 0.0)) {
+    slip_x_[p] = slip_y_[p] = 0.0;
+    w[0] = w[1] = w[2] = w[3] = 0.0;
+    return false;
+  }
+  const Vec2 g{gx / area, gy / area};
+  out.point = g;
+  out.energy = 0.5 * kn_t_[p] * energy2;
+  out.fb = force;
+  out.mb = mb, out.ma = ma;
+  out.stored = 0.0;
+  out.fric_b = {};
+  out.fric_mb = out.fric_ma = 0.0;
+  if (mu_ > 0.0) {
+    // Relative displacement of b's material point at g with respect to a's over the last step.
+    const double ub_x = r.vx[b] - r.omega[b] * (g.y - cb_y), ub_y = r.vy[b] + r.omega[b] * (g.x - cb_x);
+    const double ua_x = r.vx[a] - r.omega[a] * (g.y - ca_y), ua_y = r.vy[a] + r.omega[a] * (g.x - ca_x);
+    const Vec2 du{dt * (ub_x - ua_x), dt * (ub_y - ua_y)};
+    const FrictionResult fr = coulomb_friction(force, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_);
+    slip_x_[p] = fr.slip.x, slip_y_[p] = fr.slip.y;
+    out.stored = fr.stored;
+    out.fric_b = fr.force;
+    out.fric_mb = (g.x - cb_x) * fr.force.y - (g.y - cb_y) * fr.force.x;
+    out.fric_ma = -((g.x - ca_x) * fr.force.y - (g.y - ca_y) * fr.force.x);
+    out.fb = out.fb + fr.force;
+    out.mb += out.fric_mb, out.ma += out.fric_ma;
+  }
+  out.damp_b = {};
+  out.damp_mb = out.damp_ma = 0.0;
+  if (damping_) {
+    const double k = beta_[p] / dt;
+    out.damp_b = {k * (force.x - w[0]), k * (force.y - w[1])};
+    out.damp_mb = k * (mb - w[2]);
+    out.damp_ma = k * (ma - w[3]);
+    out.fb = out.fb + out.damp_b;
+    out.mb += out.damp_mb, out.ma += out.damp_ma;
+  }
+  w[0] = force.x, w[1] = force.y, w[2] = mb, w[3] = ma;
+  return true;
+}
+
+void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger) {
+  RigidBodies& r = model.rigid;
+  if (!detected_) {
+    ledger.contact = 0.0;
+    return;
+  }
+  world_pieces(model);
+  double energy = 0.0, stored = 0.0;
+  std::int64_t active = 0;
+  PairOut out;
+  const std::size_t np = pair_a_.size();
+  for (std::size_t p = 0; p < np; ++p) {
+    if (!evaluate(p, model, dt, out)) continue;
+    ++active;
+    energy += out.energy;
+    stored += out.stored;
+    const Index a = pair_a_[p], b = pair_b_[p];
+    r.fx[b] += out.fb.x, r.fy[b] += out.fb.y, r.torque[b] += out.mb;
+    r.fx[a] -= out.fb.x, r.fy[a] -= out.fb.y, r.torque[a] += out.ma;
+    if (damping_) {
+      damp_now_[3 * b] += out.damp_b.x, damp_now_[3 * b + 1] += out.damp_b.y;
+      damp_now_[3 * b + 2] += out.damp_mb;
+      damp_now_[3 * a] -= out.damp_b.x, damp_now_[3 * a + 1] -= out.damp_b.y;
+      damp_now_[3 * a + 2] += out.damp_ma;
+    }
+    if (mu_ > 0.0) {
+      fric_now_[3 * b] += out.fric_b.x, fric_now_[3 * b + 1] += out.fric_b.y;
+      fric_now_[3 * b + 2] += out.fric_mb;
+      fric_now_[3 * a] -= out.fric_b.x, fric_now_[3 * a + 1] -= out.fric_b.y;
+      fric_now_[3 * a + 2] += out.fric_ma;
+    }
+  }
+  active_ = active;
+  ledger.contact = energy + stored;
+  // Work of the tracked forces over the last position increment (trapezoid), bodies in order.
+  auto work_and_shift = [&](std::vector<double>& now, std::vector<double>& prev) {
+    double work = 0.0;
+    const std::size_t nb = model.blocks.size();
+    for (std::size_t b = 0; b < nb; ++b) {
+      const double* f = &now[3 * b];
+      double* g = &prev[3 * b];
+      if (!model.blocks[b].fixed && r.mass[b] > 0.0)
+        work += (f[0] + g[0]) * r.vx[b] + (f[1] + g[1]) * r.vy[b] + (f[2] + g[2]) * r.omega[b];
+      g[0] = f[0], g[1] = f[1], g[2] = f[2];
+      now[3 * b] = now[3 * b + 1] = now[3 * b + 2] = 0.0;
+    }
+    return 0.5 * dt * work;
+  };
+  if (damping_) ledger.impact_dissipated -= work_and_shift(damp_now_, damp_prev_);
+  if (mu_ > 0.0) {
+    const double taken = -work_and_shift(fric_now_, fric_prev_) - (stored - stored_prev_);
+    if (taken > 0.0) ledger.friction_dissipated += taken;
+    stored_prev_ = stored;
+  }
+}
+
+std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double dt) const {
+  std::vector<BlockPairForce> forces;
+  if (!detected_) return forces;
+  RigidContact copy(*this);
+  if (copy.needs_detection(model)) copy.detect(model);
+  copy.world_pieces(model);
+  const RigidBodies& r = model.rigid;
+  PairOut out;
+  for (std::size_t p = 0; p < copy.pair_a_.size(); ++p) {
+    if (!copy.evaluate(p, model, dt, out)) continue;
+    BlockPairForce f;
+    f.block_a = copy.pair_a_[p], f.block_b = copy.pair_b_[p];
+    f.force = out.fb;
+    f.origin = {r.cx[f.block_b], r.cy[f.block_b]};
+    f.moment = out.mb;
+    if (model.blocks[std::size_t(f.block_b)].fixed || !(r.mass[f.block_b] > 0.0)) {
+      // The moment on b about a fixed point: the forces on a are the negated ones, and their
+      // moment about c_a is out.ma; about any origin the moment on b is minus a's.
+      f.origin = {r.cx[f.block_a], r.cy[f.block_a]};
+      f.moment = -out.ma;
+    }
+    forces.push_back(f);
+  }
+  return forces;
+}
+
+namespace {
+
+template <class T>
+void put(std::vector<char>& out, const std::vector<T>& v) {
+  const std::uint64_t n = v.size();
+  const char* p = reinterpret_cast<const char*>(&n);
+  out.insert(out.end(), p, p + sizeof n);
+  p = reinterpret_cast<const char*>(v.data());
+  out.insert(out.end(), p, p + n * sizeof(T));
+}
+
+template <class T>
+std::vector<T> take(const std::vector<char>& in, std::size_t& at) {
+  std::uint64_t n = 0;
+  if (at + sizeof n > in.size()) throw std::runtime_error("rigid contact state: truncated");
+  std::memcpy(&n, in.data() + at, sizeof n);
+  at += sizeof n;
+  if (n > (in.size() - at) / sizeof(T)) throw std::runtime_error("rigid contact state: truncated");
+  std::vector<T> v(n);
+  std::memcpy(v.data(), in.data() + at, n * sizeof(T));
+  at += n * sizeof(T);
+  return v;
+}
+
+}  // namespace
+
+std::vector<char> RigidContact::save_state() const {
+  std::vector<char> out;
+  put(out, std::vector<std::int64_t>{detected_ ? 1 : 0, detections_, active_});
+  put(out, ref_cx_), put(out, ref_cy_), put(out, ref_theta_);
+  put(out, pair_a_), put(out, pair_b_);
+  put(out, slip_x_), put(out, slip_y_), put(out, last_w_);
+  put(out, damp_prev_), put(out, fric_prev_);
+  put(out, std::vector<double>{stored_prev_});
+  return out;
+}
+
+void RigidContact::restore_state(const Model& model, const std::vector<char>& bytes) {
+  std::size_t at = 0;
+  const auto head = take<std::int64_t>(bytes, at);
+  if (head.size() != 3) throw std::runtime_error("rigid contact state: bad header");
+  const auto cx = take<double>(bytes, at), cy = take<double>(bytes, at), th = take<double>(bytes, at);
+  auto pa = take<Index>(bytes, at), pb = take<Index>(bytes, at);
+  auto sx = take<double>(bytes, at), sy = take<double>(bytes, at), w = take<double>(bytes, at);
+  auto dp = take<double>(bytes, at), fp = take<double>(bytes, at);
+  const auto sp = take<double>(bytes, at);
+  const std::size_t nb = model.blocks.size();
+  if (sx.size() != pa.size() || sy.size() != pa.size() || w.size() != 4 * pa.size() ||
+      pb.size() != pa.size() || dp.size() != 3 * nb || fp.size() != 3 * nb || sp.size() != 1)
+    throw std::runtime_error("rigid contact state does not fit this model");
+  if (head[0]) {
+    if (cx.size() != nb || cy.size() != nb || th.size() != nb)
+      throw std::runtime_error("rigid contact state does not fit this model");
+    // The last detection again, from the bodies' poses then: the same candidates and reference.
+    Model at_detection = model;
+    at_detection.rigid.cx = cx, at_detection.rigid.cy = cy, at_detection.rigid.theta = th;
+    pair_a_.clear(), pair_b_.clear(), slip_x_.clear(), slip_y_.clear(), last_w_.clear();
+    detect(at_detection);
+    if (pair_a_ != pa || pair_b_ != pb)
+      throw std::runtime_error("rigid contact state: the candidate pairs differ from the model's");
+  }
+  slip_x_ = sx, slip_y_ = sy, last_w_ = w;
+  damp_prev_ = dp, fric_prev_ = fp;
+  stored_prev_ = sp[0];
+  detections_ = head[1];
+  active_ = head[2];
+}
+
+}  // namespace voussoir

@@ -1,0 +1,194 @@
+#pragma once
+// Contact of rigid blocks: one joint law between block outlines, integrated exactly (SPEC
+// section 1, "Contact of rigid blocks").
+//
+// The law. Two blocks A and B touch where their outlines overlap. On the overlap O the joint
+// carries a normal pressure kn x d (no tension), d the penetration measured along the contact
+// normal n, and a shear stress capped by Coulomb friction. With s the coordinate along the
+// contact and d(s) the width of O along n at s,
+//     F_n = kn t_z integral d(s) ds = kn t_z |O|                     (normal force, along n)
+// and its line of action passes through the centroid G of O: the moment of the pressure
+// about any point, integral kn d(s) (s - s0) ds, is kn |O| (s_G - s0), the first moment of O.
+// The elastic energy of the joint's springs is
+//     U = kn t_z / 2 integral d(s)^2 ds,
+// and F_n = dU/dd for a rigid approach along n, so the ledger books U as contact energy.
+// For rigid blocks on a straight face d(s) is linear, so all three are closed forms in the
+// vertices of O: a face-to-face joint (O a thin quadrilateral, d linear), a hinge (O a thin
+// triangle, the pressure block of the contact strip) and a corner pushed into a face (O a
+// triangle, d a tent) are the same computation. This is the Winkler (Cundall's UDEC and
+// 3DEC, DIANA's interface) joint law for the joint's stiffness kn in N/m3.
+//
+// The normal. O is convex when both outlines are (below: non-convex ones are cut into convex
+// pieces). Its boundary is made of pieces of A's boundary (inside B) and pieces of B's
+// (inside A); with N_A the sum of A's outward normals times lengths over A's pieces, N_A =
+// -N_B (a closed polygon), |N_A| is the length of the chord between the two points where the
+// outlines cross, and n = N_A / |N_A| points out of A into B. It is the gradient of |O| with
+// respect to a translation of B (Feng, Han and Owen, "Energy-conserving contact interaction
+// models for arbitrarily shaped discrete elements", CMAME 205 (2012)): normal to the chord.
+// On a face-to-face joint the chord runs along the joint to within the penetration over the
+// joint's length (1e-9 at rest); for a corner in a face it is the face. F_n acts on B along
+// +n, on A along -n.
+//
+// Exactness. |O|, G and N_A come from the vertices of O by Green's theorem: with O's
+// vertices v_k (counter-clockwise) relative to a point of O,
+//     |O| = 1/2 sum v_k x v_k+1,   G |O| = 1/6 sum (v_k + v_k+1) (v_k x v_k+1).
+// integral d^2 ds: between consecutive abscissae s_j of O's vertices along the chord, d is
+// linear, so that interval gives (s_j+1 - s_j)(d_j^2 + d_j d_j+1 + d_j+1^2) / 3, d_j the width
+// of O at s_j (its two edges there). O itself comes from clipping A's piece by each side line
+// of B's piece (Sutherland and Hodgman, CACM 17 (1974)), each vertex carrying which of the two
+// boundaries its outgoing edge lies on, so N_A needs no tolerance even for slivers of 1e-10 m.
+// A line of B that has every vertex on its inner side is skipped (a joint's overlap is cut by
+// one or two of B's sides).
+//
+// Non-convex outlines (the church's crown blocks) are cut once, in the reference
+// configuration, into convex pieces: the block's own triangles merged greedily across shared
+// edges while the union stays convex (Hertel and Mehlhorn). A block pair sums its piece
+// pairs' overlaps: forces and moments add; where a joint crosses a cut, its overlap is split
+// in two at the cut and the two halves carry the same pressure (their normals differ by the
+// penetration over the piece's length).
+//
+// Friction. One state per block pair: the elastic slip s (a 2D vector) of friction.hpp's
+// Coulomb law, at the area-weighted centroid G of the pair's overlaps, along the tangent of
+// the pair's normal force, with the shear spring k_t = ks t_z L (L: the length of the pair's
+// joint, or for blocks that were not joined, the shorter of their longest sides). Kept
+// constant per pair so that 1/2 k_t s^2 is an honest energy. (Rejected: k_t following the
+// contact length; the stored energy would change without work when a hinge opens.) The slip
+// increment is the relative displacement of B's and A's material points at G over the last
+// step, dt times the rigid velocity field of the half step.
+//
+// Impact damping (contact.restitution < 1): the dashpot beta dW/dt on the rate of the pair's
+// normal-force wrench W = (F_n, its moment about each block's centroid), beta = 2 zeta /
+// omega as in joint_stiffness.hpp (omega the joint's frequency with the blocks' masses), by
+// the backward difference; this is beta K qdot, the stiffness-proportional dashpot of the
+// joint, and it damps a block rocking on its joint (the moment changes) as well as a bounce.
+// A pair that stops touching drops its history and gets no dashpot force (no tension).
+//
+// Ledger: the dashpots' and friction's generalized forces on each body are booked by the
+// trapezoid over the body's position increment (dt v^(n-1/2), dt omega^(n-1/2)), as the
+// element damping of core/; friction books its work less the change of its springs' energy.
+//
+// Detection: the NBS grid of contact/broad_phase.hpp on the blocks' outline triangles, node
+// positions taken from the bodies at detection only, candidate triangle pairs folded into
+// candidate block pairs. A new detection is due when some body has moved a point of its
+// outline by more than buffer / 2 (bounded by |dc| + R |dtheta|, R the farthest outline point).
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "contact/broad_phase.hpp"
+#include "core/energy.hpp"
+#include "core/model.hpp"
+
+namespace voussoir {
+
+struct ContactParams;
+
+// Overlap of two convex polygons P and Q (counter-clockwise), the pure part of the law above.
+struct ConvexOverlap {
+  double area = 0.0;      // |O| [m2]
+  Vec2 centroid;          // G [m]
+  Vec2 normal;            // n, unit, out of P into Q
+  double chord = 0.0;     // |N_P| [m]
+  double depth_sq = 0.0;  // integral of d(s)^2 ds along the chord [m3]
+};
+
+// Most vertices a convex piece may have (a piece is cut further when larger).
+inline constexpr int kMaxPieceVertices = 16;
+
+// The overlap of P (np vertices) and Q (nq vertices); false when they do not overlap (or O has
+// no area, or P lies wholly inside Q and O has no chord).
+bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out);
+
+// Force of a touching block pair (a, b) as the contact stage applies it: the sum of the normal
+// force, friction and dashpot on b, and the moment of all of them about `origin` [N, N m].
+struct BlockPairForce {
+  Index block_a = 0, block_b = 0;
+  Vec2 force;          // on b (minus this on a) [N]
+  Vec2 origin;         // point the moment is taken about [m]
+  double moment = 0.0; // of the forces on b about origin [N m]
+};
+
+class RigidContact {
+ public:
+  // Outlines, convex pieces, per-block constants, the broad phase. `penalty` [Pa] and
+  // `block_min_height` (per block [m]) serve the penalty mode (no joint stiffness given).
+  void setup(const Model& model, const ContactParams& params, double penalty,
+             const std::vector<double>& block_min_height);
+  bool needs_detection(const Model& model) const;
+  void detect(const Model& model);
+  // Adds the contact forces and moments to model.rigid's fx, fy, torque; sets ledger.contact,
+  // books friction and impact dissipation.
+  void add_forces(Model& model, double dt, EnergyLedger& ledger);
+  // The force of every touching pair, evaluated on a copy (the run's state untouched).
+  std::vector<BlockPairForce> pair_forces(const Model& model, double dt) const;
+
+  std::int64_t candidate_pairs() const { return std::int64_t(pair_a_.size()); }
+  std::int64_t active_pairs() const { return active_; }
+  std::int64_t detections() const { return detections_; }
+  double buffer() const { return broad_.buffer(); }
+
+  std::vector<char> save_state() const;
+  void restore_state(const Model& model, const std::vector<char>& bytes);
+
+ private:
+  struct PairOut {
+    Vec2 fb;                 // all forces on b [N]
+    double mb = 0.0, ma = 0.0;  // moments on b about c_b, on a about c_a [N m]
+    Vec2 damp_b;             // dashpot part of fb
+    double damp_mb = 0.0, damp_ma = 0.0;
+    Vec2 fric_b;             // friction part of fb
+    double fric_mb = 0.0, fric_ma = 0.0;
+    double energy = 0.0, stored = 0.0;
+    Vec2 point;              // G
+  };
+  void world_pieces(const Model& model);
+  bool evaluate(std::size_t p, const Model& model, double dt, PairOut& out);
+  void pair_constants(const Model& model);
+
+  // Parameters.
+  double mu_ = 0.0, thickness_ = 1.0, zeta_ = 0.0;
+  double kn_given_ = 0.0, ks_given_ = 0.0, young_ = 0.0, penalty_ = 0.0;
+  bool damping_ = false;
+  std::vector<double> min_height_;  // per block [m] (penalty mode)
+
+  // Convex pieces: piece k has vertices [piece_first_[k], piece_first_[k + 1]) in ref_x_/ref_y_
+  // (offsets from the body's reference centroid for free blocks, absolute for fixed ones);
+  // block b has pieces [block_piece_[b], block_piece_[b + 1]).
+  std::vector<Index> piece_first_, block_piece_;
+  std::vector<double> ref_x_, ref_y_;
+  // Current configuration (free blocks rewritten each step): vertices and piece boxes.
+  std::vector<Vec2> world_;
+  std::vector<double> box_lo_x_, box_lo_y_, box_hi_x_, box_hi_y_;  // per piece
+  // Per block: farthest outline point from the reference centroid [m], longest side [m].
+  std::vector<double> radius_, longest_side_;
+  // Joints between block pairs (model.joints), for the pair constants.
+  struct JointInfo {
+    Index a, b;  // a < b
+    double length;
+    Vec2 tangent;
+  };
+  std::vector<JointInfo> joints_;  // sorted by (a, b), lengths summed per pair
+
+  // Broad phase on the outline triangles, with node positions from the bodies.
+  BroadPhase broad_;
+  Nodes scratch_;
+  std::vector<IndexPair> tri_pairs_;
+  std::vector<double> ref_cx_, ref_cy_, ref_theta_;  // body poses at the last detection
+  bool detected_ = false;
+
+  // Candidate block pairs (a < b), sorted, with their constants and state.
+  std::vector<Index> pair_a_, pair_b_;
+  std::vector<double> kn_t_, kt_, beta_;       // [N/m2], [N/m], [s]
+  std::vector<double> slip_x_, slip_y_;        // friction state [m]
+  std::vector<double> last_w_;                 // 4 per pair: F_x, F_y, M_b, M_a of the last step
+
+  // Ledger: per body (3 values: x, y, rotation) the dashpot and friction forces of this and of
+  // the last step.
+  std::vector<double> damp_now_, damp_prev_, fric_now_, fric_prev_;
+  double stored_prev_ = 0.0;
+
+  std::int64_t active_ = 0, detections_ = 0;
+};
+
+}  // namespace voussoir
