@@ -884,14 +884,14 @@ void ContactSystem::Impl::accumulate(Model& model, double dt, EnergyLedger& ledg
   }
 }
 
-void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger) {
+void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger, bool energy) {
   Impl& s = *impl_;
   if (!s.ready) {
     ledger.contact = 0.0;
     return;
   }
   if (s.rigid_mode) {
-    s.rigid.add_forces(model, dt, ledger);
+    s.rigid.add_forces(model, dt, ledger, energy);
     return;
   }
   // Branch once: with mu = 0 no friction code runs at all; below kSkinPairs no skip.

@@ -68,9 +68,11 @@ class ContactSystem {
   bool needs_detection(const Model& model) const;
   // Broad phase: rebuilds the candidate pair list (friction history carried over by key).
   void detect(const Model& model);
-  // Narrow phase + friction: adds contact forces into nodes.fx/fy, sets ledger.contact and
-  // accumulates ledger.friction_dissipated and ledger.impact_dissipated.
-  void add_forces(Model& model, double dt, EnergyLedger& ledger);
+  // Narrow phase + friction: adds contact forces into nodes.fx/fy (rigid blocks: into the
+  // bodies' force and moment), sets ledger.contact and accumulates ledger.friction_dissipated
+  // and ledger.impact_dissipated. energy false lets rigid blocks leave ledger.contact as it is
+  // (StepContext::contact_energy); elastic blocks always set it.
+  void add_forces(Model& model, double dt, EnergyLedger& ledger, bool energy = true);
 
   // The force of every touching pair at the current node positions and velocities, in pair
   // order: what the next add_forces would apply, evaluated on a copy of this system (detection

@@ -21,10 +21,15 @@ constexpr std::uint8_t kOnP = 0, kOnQ = 1;
 // Largest vertex count of a clipped polygon: P's vertices plus two per line of Q.
 constexpr int kMaxClipped = 3 * kMaxPieceVertices + 4;
 
+// A point of the kernel's scratch arrays (no initialiser: the arrays are written before read).
+struct Pt {
+  double x, y;
+};
+
 // Clips the convex polygon (in, n) by the inner side of a line of Q (d: each vertex's signed
 // distance to it times the side's length, >= 0 inside); returns the vertex count of `out`
 // (Sutherland-Hodgman with the edge labels of rigid_contact.hpp).
-int clip_by_line(const Vec2* in, const std::uint8_t* in_on, int n, const double* d, Vec2* out,
+int clip_by_line(const Pt* in, const std::uint8_t* in_on, int n, const double* d, Pt* out,
                  std::uint8_t* out_on) {
   int m = 0;
   int prev = n - 1;
@@ -44,6 +49,37 @@ int clip_by_line(const Vec2* in, const std::uint8_t* in_on, int n, const double*
     prev = k;
   }
   return m;
+}
+
+// integral of d(s)^2 ds of the convex polygon (s, h) (n vertices, counter-clockwise in the
+// right-handed frame (s, h)): from the leftmost vertex the lower chain runs forward and the
+// upper chain backward to the rightmost one, both with growing s; between consecutive
+// abscissae of either chain d = upper - lower is linear (rigid_contact.hpp).
+double width_squared_integral(const double* s, const double* h, int n) {
+  int i0 = 0, i1 = 0;
+  for (int k = 1; k < n; ++k) {
+    if (s[k] < s[i0] || (s[k] == s[i0] && h[k] < h[i0])) i0 = k;
+    if (s[k] > s[i1] || (s[k] == s[i1] && h[k] > h[i1])) i1 = k;
+  }
+  if (i0 == i1) return 0.0;
+  auto next = [n](int k) { return k + 1 < n ? k + 1 : 0; };
+  auto prev = [n](int k) { return k > 0 ? k - 1 : n - 1; };
+  // Current segments: lower (la -> lb), upper (ua -> ub), each with s[b] > s[a].
+  int la = i0, lb = next(i0), ua = i0, ub = prev(i0);
+  while (la != i1 && !(s[lb] > s[la])) la = lb, lb = next(lb);
+  while (ua != i1 && !(s[ub] > s[ua])) ua = ub, ub = prev(ub);
+  double at = s[i0], integral = 0.0;
+  while (la != i1 && ua != i1) {
+    const double end = std::min(s[lb], s[ub]);
+    const double gl = (h[lb] - h[la]) / (s[lb] - s[la]), gu = (h[ub] - h[ua]) / (s[ub] - s[ua]);
+    const double w0 = (h[ua] + gu * (at - s[ua])) - (h[la] + gl * (at - s[la]));
+    const double w1 = (h[ua] + gu * (end - s[ua])) - (h[la] + gl * (end - s[la]));
+    integral += (end - at) * (w0 * w0 + w0 * w1 + w1 * w1);
+    at = end;
+    while (la != i1 && !(s[lb] > at)) la = lb, lb = next(lb);
+    while (ua != i1 && !(s[ub] > at)) ua = ub, ub = prev(ub);
+  }
+  return integral / 3.0;
 }
 
 // Is the counter-clockwise polygon convex (collinear vertices allowed)?
@@ -103,20 +139,23 @@ std::vector<std::vector<Index>> merged_triangles(const Model& model, Index b) {
 
 }  // namespace
 
-bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out) {
-  Vec2 buf[2][kMaxClipped];
+bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
+                    bool with_energy) {
+  Pt buf[2][kMaxClipped];
   std::uint8_t on[2][kMaxClipped];
   double d[kMaxClipped];
   // Coordinates relative to P's first vertex: the sliver's sums then cancel less.
-  const Vec2 o = p[0];
+  const double ox = p[0].x, oy = p[0].y;
   int n = np, cur = 0;
-  for (int k = 0; k < np; ++k) buf[0][k] = p[k] - o, on[0][k] = kOnP;
+  for (int k = 0; k < np; ++k) buf[0][k] = {p[k].x - ox, p[k].y - oy}, on[0][k] = kOnP;
   for (int j = 0; j < nq; ++j) {
-    const Vec2 a = q[j] - o, b = q[(j + 1) % nq] - o;
-    const Vec2 e = b - a;
+    const int j1 = j + 1 < nq ? j + 1 : 0;
+    const double ax = q[j].x - ox, ay = q[j].y - oy;
+    const double ex = q[j1].x - q[j].x, ey = q[j1].y - q[j].y;
     bool all_in = true, all_out = true;
+    const Pt* v = buf[cur];
     for (int k = 0; k < n; ++k) {
-      d[k] = cross(e, buf[cur][k] - a);
+      d[k] = ex * (v[k].y - ay) - ey * (v[k].x - ax);
       all_in = all_in && d[k] >= 0.0;
       all_out = all_out && d[k] < 0.0;
     }
@@ -126,66 +165,63 @@ bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap&
     cur = 1 - cur;
     if (n < 3) return false;
   }
-  const Vec2* v = buf[cur];
+  const Pt* v = buf[cur];
   const std::uint8_t* lab = on[cur];
-  // Area, first moment and P's outward normals (Green's theorem).
+  // Area and first moment about O's first vertex (Green's theorem: a sliver's terms are then
+  // each of its own size), and P's outward normals times lengths.
+  const double vx0 = v[0].x, vy0 = v[0].y;
   double a2 = 0.0, mx = 0.0, my = 0.0, npx = 0.0, npy = 0.0, nqx = 0.0, nqy = 0.0;
   for (int k = 0; k < n; ++k) {
-    const Vec2 v0 = v[k], v1 = v[k + 1 < n ? k + 1 : 0];
-    const double c = cross(v0, v1);
+    const int k1 = k + 1 < n ? k + 1 : 0;
+    const double x0 = v[k].x - vx0, y0 = v[k].y - vy0, x1 = v[k1].x - vx0, y1 = v[k1].y - vy0;
+    const double c = x0 * y1 - y0 * x1;
     a2 += c;
-    mx += (v0.x + v1.x) * c;
-    my += (v0.y + v1.y) * c;
+    mx += (x0 + x1) * c;
+    my += (y0 + y1) * c;
     if (lab[k] == kOnP) {
-      npx += v1.y - v0.y, npy -= v1.x - v0.x;
+      npx += y1 - y0, npy -= x1 - x0;
     } else {
-      nqx += v1.y - v0.y, nqy -= v1.x - v0.x;
+      nqx += y1 - y0, nqy -= x1 - x0;
     }
   }
   if (!(a2 > 0.0)) return false;
   const double nx = 0.5 * (npx - nqx), ny = 0.5 * (npy - nqy);
-  const double chord = std::hypot(nx, ny);
+  const double chord = std::sqrt(nx * nx + ny * ny);
   if (!(chord > 0.0)) return false;
   out.area = 0.5 * a2;
-  out.centroid = {o.x + mx / (3.0 * a2), o.y + my / (3.0 * a2)};
+  out.centroid = {ox + vx0 + mx / (3.0 * a2), oy + vy0 + my / (3.0 * a2)};
   out.normal = {nx / chord, ny / chord};
   out.chord = chord;
-  // integral d(s)^2 ds: s along t = (-n_y, n_x), h along n; between consecutive abscissae the
-  // width is linear (rigid_contact.hpp).
-  const Vec2 tn{-out.normal.y, out.normal.x};
-  double s[kMaxClipped], h[kMaxClipped], sorted[kMaxClipped];
+  out.depth_sq = 0.0;
+  if (!with_energy) return true;
+  // integral d^2 ds in the frame s along (n_y, -n_x), h along n (right-handed).
+  double s[kMaxClipped], h[kMaxClipped];
+  const double tx = out.normal.y, ty = -out.normal.x;
   for (int k = 0; k < n; ++k) {
-    s[k] = dot(tn, v[k]);
-    h[k] = dot(out.normal, v[k]);
-    sorted[k] = s[k];
+    s[k] = tx * v[k].x + ty * v[k].y;
+    h[k] = out.normal.x * v[k].x + out.normal.y * v[k].y;
   }
-  std::sort(sorted, sorted + n);
-  double integral = 0.0;
-  for (int j = 0; j + 1 < n; ++j) {
-    const double s0 = sorted[j], s1 = sorted[j + 1];
-    if (!(s1 > s0)) continue;
-    const double sm = 0.5 * (s0 + s1);
-    // The two edges spanning the interval: their heights at s0 and s1.
-    double lo0 = 0.0, lo1 = 0.0, hi0 = 0.0, hi1 = 0.0;
-    int found = 0;
-    for (int k = 0; k < n && found < 2; ++k) {
-      const int k1 = k + 1 < n ? k + 1 : 0;
-      const double sa = s[k], sb = s[k1];
-      if (!((sa <= sm && sm <= sb) || (sb <= sm && sm <= sa)) || sa == sb) continue;
-      const double slope = (h[k1] - h[k]) / (sb - sa);
-      const double e0 = h[k] + slope * (s0 - sa), e1 = h[k] + slope * (s1 - sa);
-      if (found == 0) {
-        lo0 = e0, lo1 = e1;
-      } else {
-        hi0 = e0, hi1 = e1;
-      }
-      ++found;
-    }
-    if (found < 2) continue;
-    const double w0 = std::abs(hi0 - lo0), w1 = std::abs(hi1 - lo1);
-    integral += (s1 - s0) * (w0 * w0 + w0 * w1 + w1 * w1) / 3.0;
+  out.depth_sq = width_squared_integral(s, h, n);
+  return true;
+}
+
+int separating_line(const Vec2* p, int np, const Vec2* q, int nq) {
+  for (int j = 0; j < nq + np; ++j) {
+    if (separated_by(p, np, q, nq, j)) return j;
   }
-  out.depth_sq = integral;
+  return -1;
+}
+
+bool separated_by(const Vec2* p, int np, const Vec2* q, int nq, int line) {
+  // Line `line` of Q (line < nq) with P's vertices, or of P (line - nq) with Q's.
+  const Vec2* owner = q;
+  const Vec2* other = p;
+  int no = nq, nt = np, j = line;
+  if (line >= nq) owner = p, other = q, no = np, nt = nq, j = line - nq;
+  const Vec2 a = owner[j], b = owner[j + 1 < no ? j + 1 : 0];
+  const double ex = b.x - a.x, ey = b.y - a.y;
+  for (int k = 0; k < nt; ++k)
+    if (ex * (other[k].y - a.y) - ey * (other[k].x - a.x) >= 0.0) return false;
   return true;
 }
 
@@ -298,8 +334,8 @@ bool RigidContact::needs_detection(const Model& model) const {
   const std::size_t nb = model.blocks.size();
   for (std::size_t b = 0; b < nb; ++b) {
     if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
-    const double moved = std::hypot(r.cx[b] - ref_cx_[b], r.cy[b] - ref_cy_[b]) +
-                         radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
+    const double dx = r.cx[b] - ref_cx_[b], dy = r.cy[b] - ref_cy_[b];
+    const double moved = std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
     if (moved > half) return true;
   }
   return false;
@@ -328,6 +364,15 @@ void RigidContact::detect(const Model& model) {
   }
   std::sort(next.begin(), next.end());
   next.erase(std::unique(next.begin(), next.end()), next.end());
+  // Keep the pairs whose outlines are within the buffer of each other: until the next
+  // detection every outline point moves by at most buffer / 2, so the others stay apart.
+  world_pieces(model);
+  const double reach = broad_.buffer();
+  next.erase(std::remove_if(next.begin(), next.end(),
+                            [&](const std::pair<Index, Index>& ab) {
+                              return !(outline_gap(ab.first, ab.second) <= reach);
+                            }),
+             next.end());
   // Carry the friction slip and the dashpot's last wrench by the block pair.
   const std::size_t np = next.size();
   std::vector<Index> na(np), nbk(np);
@@ -344,11 +389,32 @@ void RigidContact::detect(const Model& model) {
     }
   }
   pair_a_.swap(na), pair_b_.swap(nbk);
+  apart_line_.assign(np, -1);
   slip_x_.swap(sx), slip_y_.swap(sy), last_w_.swap(w);
   pair_constants(model);
   ref_cx_ = r.cx, ref_cy_ = r.cy, ref_theta_ = r.theta;
   detected_ = true;
   ++detections_;
+}
+
+// Smallest distance between the outlines of blocks a and b at the current configuration (0 when
+// they overlap) [m].
+double RigidContact::outline_gap(Index a, Index b) const {
+  double gap = std::numeric_limits<double>::infinity();
+  for (Index i = block_piece_[a]; i < block_piece_[a + 1]; ++i)
+    for (Index j = block_piece_[b]; j < block_piece_[b + 1]; ++j) {
+      const Vec2* p = &world_[piece_first_[i]];
+      const Vec2* q = &world_[piece_first_[j]];
+      const int np = piece_first_[i + 1] - piece_first_[i];
+      const int nq = piece_first_[j + 1] - piece_first_[j];
+      if (separating_line(p, np, q, nq) < 0) return 0.0;  // convex pieces not apart: overlap
+      for (int k = 0; k < np; ++k)
+        for (int l = 0; l < nq; ++l) {
+          gap = std::min(gap, distance_to_segment(p[k], q[l], q[l + 1 < nq ? l + 1 : 0]));
+          gap = std::min(gap, distance_to_segment(q[l], p[k], p[k + 1 < np ? k + 1 : 0]));
+        }
+    }
+  return gap;
 }
 
 // kn t_z, k_t and beta of each candidate pair, from the reference geometry only (so a restart's
@@ -419,22 +485,31 @@ void RigidContact::world_pieces(const Model& model) {
 
 // Pair p at the current configuration: false when its blocks do not overlap (its history is
 // then dropped).
-bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, PairOut& out) {
+bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool energy,
+                            PairOut& out) {
   const RigidBodies& r = model.rigid;
   const Index a = pair_a_[p], b = pair_b_[p];
   double area = 0.0, energy2 = 0.0, gx = 0.0, gy = 0.0;
   Vec2 force;
   double mb = 0.0, ma = 0.0;
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
+  const bool single = block_piece_[a + 1] - block_piece_[a] == 1 &&
+                      block_piece_[b + 1] - block_piece_[b] == 1;
   for (Index i = block_piece_[a]; i < block_piece_[a + 1]; ++i)
     for (Index j = block_piece_[b]; j < block_piece_[b + 1]; ++j) {
       if (box_lo_x_[i] > box_hi_x_[j] || box_lo_x_[j] > box_hi_x_[i] ||
           box_lo_y_[i] > box_hi_y_[j] || box_lo_y_[j] > box_hi_y_[i])
         continue;
+      const Vec2* pv = &world_[piece_first_[i]];
+      const Vec2* qv = &world_[piece_first_[j]];
+      const int np = piece_first_[i + 1] - piece_first_[i];
+      const int nq = piece_first_[j + 1] - piece_first_[j];
+      if (single && apart_line_[p] >= 0 && separated_by(pv, np, qv, nq, apart_line_[p])) continue;
       ConvexOverlap o;
-      if (!convex_overlap(&world_[piece_first_[i]], piece_first_[i + 1] - piece_first_[i],
-                          &world_[piece_first_[j]], piece_first_[j + 1] - piece_first_[j], o))
+      if (!convex_overlap(pv, np, qv, nq, o, energy)) {
+        if (single) apart_line_[p] = std::int16_t(separating_line(pv, np, qv, nq));
         continue;
+      }
       const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b
       force = force + f;
       mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
@@ -485,7 +560,7 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, PairOu
   return true;
 }
 
-void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger) {
+void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, bool with_energy) {
   RigidBodies& r = model.rigid;
   if (!detected_) {
     ledger.contact = 0.0;
@@ -497,7 +572,7 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger) {
   PairOut out;
   const std::size_t np = pair_a_.size();
   for (std::size_t p = 0; p < np; ++p) {
-    if (!evaluate(p, model, dt, out)) continue;
+    if (!evaluate(p, model, dt, with_energy, out)) continue;
     ++active;
     energy += out.energy;
     stored += out.stored;
@@ -518,7 +593,7 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger) {
     }
   }
   active_ = active;
-  ledger.contact = energy + stored;
+  if (with_energy) ledger.contact = energy + stored;
   // Work of the tracked forces over the last position increment (trapezoid), bodies in order.
   auto work_and_shift = [&](std::vector<double>& now, std::vector<double>& prev) {
     double work = 0.0;
@@ -550,7 +625,7 @@ std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double
   const RigidBodies& r = model.rigid;
   PairOut out;
   for (std::size_t p = 0; p < copy.pair_a_.size(); ++p) {
-    if (!copy.evaluate(p, model, dt, out)) continue;
+    if (!copy.evaluate(p, model, dt, true, out)) continue;
     BlockPairForce f;
     f.block_a = copy.pair_a_[p], f.block_b = copy.pair_b_[p];
     f.force = out.fb;

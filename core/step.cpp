@@ -157,7 +157,7 @@ void advance(Simulation& sim) {
 
   // 4. contact forces (sets ledger.contact, accumulates friction dissipation)
   if (ctx.contact_on) {
-    sim.contact.add_forces(model, ctx.dt, ledger);
+    sim.contact.add_forces(model, ctx.dt, ledger, ctx.contact_energy);
   } else {
     ledger.contact = 0.0;
   }

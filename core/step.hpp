@@ -31,6 +31,12 @@ struct StepContext {
   double shear_modulus = 0.0;
   double eta = 0.0;  // Munjiza viscosity [Pa s]
   bool contact_on = true;
+  // Rigid blocks: compute the joints' elastic energy (ledger.contact) at this step. The engine
+  // asks for it at the steps whose ledger is read (samples, ends); between them ledger.contact
+  // keeps its last value, which only max_energy reads (bounded by the external work anyway).
+  // The joint energy is a third of a touching pair's cost. Tests that read the ledger at every
+  // step keep the default.
+  bool contact_energy = true;
   // Cundall's local damping coefficient alpha of the quasi-static phases (core/integrate.hpp
   // LocalDamping); 0 = off (every physical run)
   double local_damping = 0.0;
