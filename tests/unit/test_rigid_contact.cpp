@@ -1,0 +1,203 @@
+// Contact of rigid blocks between outlines (contact/rigid_contact.hpp): the overlap integrals
+// against hand-computed values (a face pressed flat, a tilted face, a corner in a face, two
+// corners), the symmetry of the law, a non-convex block resting on two legs, and the
+// quasi-static capacity of a rigid block on a Winkler joint against the closed form of its
+// contact strip at three joint stiffnesses.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "contact/rigid_contact.hpp"
+#include "core/rigid.hpp"
+#include "core/step.hpp"
+#include "drivers/capacity.hpp"
+#include "drivers/setup.hpp"
+#include "io/deck.hpp"
+
+namespace voussoir {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<Vec2> box(double x0, double y0, double x1, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+}
+
+ConvexOverlap overlap(const std::vector<Vec2>& p, const std::vector<Vec2>& q) {
+  ConvexOverlap o;
+  EXPECT_TRUE(convex_overlap(p.data(), int(p.size()), q.data(), int(q.size()), o));
+  return o;
+}
+
+// A block pressed flat into a face: O = [0.2, 0.8] x [0.99, 1], the pressure uniform.
+TEST(RigidContact, FacePressedFlatIsAUniformStrip) {
+  const ConvexOverlap o = overlap(box(0, 0, 1, 1), box(0.2, 0.99, 0.8, 2.0));
+  EXPECT_NEAR(o.area, 0.6 * 0.01, 1e-15);
+  EXPECT_NEAR(o.centroid.x, 0.5, 1e-12);
+  EXPECT_NEAR(o.centroid.y, 0.995, 1e-12);
+  EXPECT_NEAR(o.normal.x, 0.0, 1e-15);
+  EXPECT_NEAR(o.normal.y, 1.0, 1e-15);  // out of P (below) into Q
+  EXPECT_NEAR(o.chord, 0.6, 1e-12);
+  EXPECT_NEAR(o.depth_sq, 0.6 * 0.01 * 0.01, 1e-17);  // integral of d^2 over the contact
+}
+
+// A block whose base is tilted: d falls linearly from 0.002 to 0 over the unit contact, the
+// pressure block of a hinge. |O| = 0.001, G a third of the way from the deep end, integral of
+// d^2 = 0.002^2 / 3.
+TEST(RigidContact, TiltedFaceIsATriangularPressureBlock) {
+  const std::vector<Vec2> ground = box(-1, -1, 1, 0);
+  const std::vector<Vec2> block = {{-0.5, -0.002}, {0.5, 0.0}, {0.5, 1.0}, {-0.5, 1.0}};
+  const ConvexOverlap o = overlap(ground, block);
+  EXPECT_NEAR(o.area, 0.001, 1e-15);
+  EXPECT_NEAR(o.centroid.x, -0.5 + 1.0 / 3.0, 1e-12);
+  EXPECT_NEAR(o.centroid.y, -0.002 / 3.0, 1e-14);
+  EXPECT_NEAR(o.normal.y, 1.0, 1e-15);
+  EXPECT_NEAR(o.depth_sq, 0.002 * 0.002 / 3.0, 1e-18);
+}
+
+// A square turned by 45 degrees pushed corner first into a face by delta: O is the triangle of
+// base 2 delta and height delta, the force along the face's normal, integral of d^2 = 2 delta^3
+// / 3 (the tent d = delta - |s|).
+TEST(RigidContact, CornerInAFaceActsAlongTheFaceNormal) {
+  const double delta = 1e-3, r = 0.5 * std::sqrt(2.0);
+  const Vec2 c{0.5, 1.0 - delta + r};
+  const std::vector<Vec2> diamond = {
+      {c.x, c.y - r}, {c.x + r, c.y}, {c.x, c.y + r}, {c.x - r, c.y}};
+  const ConvexOverlap o = overlap(box(0, 0, 1, 1), diamond);
+  EXPECT_NEAR(o.area, delta * delta, 1e-15);
+  EXPECT_NEAR(o.centroid.x, 0.5, 1e-12);
+  EXPECT_NEAR(o.centroid.y, 1.0 - delta / 3.0, 1e-12);
+  EXPECT_NEAR(o.normal.x, 0.0, 1e-12);
+  EXPECT_NEAR(o.normal.y, 1.0, 1e-12);
+  EXPECT_NEAR(o.depth_sq, 2.0 * delta * delta * delta / 3.0, 1e-15 * delta);
+}
+
+// Two corners overlapping: O = [0.5, 1] x [0.9, 1]; the normal is that of the chord between
+// the points where the outlines cross, (1, 0.9) and (0.5, 1). Swapping the blocks negates the
+// normal and keeps everything else.
+TEST(RigidContact, TwoCornersTakeTheChordsNormalAndSwappingNegatesIt) {
+  const std::vector<Vec2> p = box(0, 0, 1, 1), q = box(0.5, 0.9, 1.5, 2.0);
+  const ConvexOverlap o = overlap(p, q), r = overlap(q, p);
+  EXPECT_NEAR(o.area, 0.05, 1e-14);
+  const double len = std::hypot(0.1, 0.5);
+  EXPECT_NEAR(o.normal.x, 0.1 / len, 1e-12);
+  EXPECT_NEAR(o.normal.y, 0.5 / len, 1e-12);
+  EXPECT_NEAR(o.chord, len, 1e-12);
+  EXPECT_NEAR(r.area, o.area, 1e-15);
+  EXPECT_NEAR(r.normal.x, -o.normal.x, 1e-12);
+  EXPECT_NEAR(r.normal.y, -o.normal.y, 1e-12);
+  EXPECT_NEAR(r.centroid.x, o.centroid.x, 1e-12);
+  EXPECT_NEAR(r.centroid.y, o.centroid.y, 1e-12);
+  EXPECT_NEAR(r.depth_sq, o.depth_sq, 1e-15);
+  // Width along the normal integrated numerically (midpoint rule on 20000 strips).
+  const Vec2 n = o.normal, t{n.y, -n.x};
+  const std::vector<Vec2> v = {{0.5, 0.9}, {1.0, 0.9}, {1.0, 1.0}, {0.5, 1.0}};
+  double lo = 1e9, hi = -1e9;
+  for (const Vec2& a : v) lo = std::min(lo, dot(a, t)), hi = std::max(hi, dot(a, t));
+  const int strips = 20000;
+  double sum = 0.0;
+  for (int k = 0; k < strips; ++k) {
+    const double s = lo + (k + 0.5) * (hi - lo) / strips;
+    double h0 = 1e9, h1 = -1e9;
+    for (int e = 0; e < 4; ++e) {
+      const Vec2 a = v[e], b = v[(e + 1) % 4];
+      const double sa = dot(a, t), sb = dot(b, t);
+      if ((s - sa) * (s - sb) > 0.0 || sa == sb) continue;
+      const double h = dot(a, n) + (dot(b, n) - dot(a, n)) * (s - sa) / (sb - sa);
+      h0 = std::min(h0, h), h1 = std::max(h1, h);
+    }
+    sum += (h1 - h0) * (h1 - h0) * (hi - lo) / strips;
+  }
+  EXPECT_NEAR(o.depth_sq, sum, 1e-6 * sum);
+}
+
+TEST(RigidContact, ApartPolygonsHaveASeparatingLine) {
+  const std::vector<Vec2> p = box(0, 0, 1, 1), q = box(1.5, 0.2, 2.0, 0.8);
+  ConvexOverlap o;
+  EXPECT_FALSE(convex_overlap(p.data(), 4, q.data(), 4, o));
+  const int line = separating_line(p.data(), 4, q.data(), 4);
+  ASSERT_GE(line, 0);
+  EXPECT_TRUE(separated_by(p.data(), 4, q.data(), 4, line));
+  const std::vector<Vec2> touching = box(0.9, 0.2, 2.0, 0.8);
+  EXPECT_EQ(separating_line(p.data(), 4, touching.data(), 4), -1);
+}
+
+// A non-convex block (a portal: two legs 0.3 m wide under a 0.5 m lintel) settles on its legs
+// by weight / (kn x 0.6 m2) and stays level, the ledger closed.
+TEST(RigidContact, NonConvexBlockRestsOnBothLegs) {
+  const fs::path dir = fs::temp_directory_path() / "voussoir_rigid_portal";
+  fs::create_directories(dir);
+  const fs::path file = dir / "portal.txt";
+  std::ofstream(file) << "block\n0 0\n0.3 0\n0.3 0.5\n0.7 0.5\n0.7 0\n1 0\n1 1\n0 1\n\n"
+                         "block\n-1 -0.5\n2 -0.5\n2 0\n-1 0\n";
+  const double kn = 1e9;
+  const std::string deck = "[model]\nkind = \"polygons\"\nfile = \"" + file.string() +
+                           "\"\nfixed = [1]\n[material]\nmodel = \"rigid\"\n[contact]\n"
+                           "friction = 0.8\nnormal_stiffness = 1e9\nrestitution = 0\n";
+  Simulation sim = make_simulation(parse_deck(deck, (dir / "portal.toml").string()));
+  double worst = 0.0;
+  while (sim.ctx.time < 0.5) {
+    advance(sim);
+    worst = std::max(worst, sim.ledger.balance_error());
+  }
+  const RigidBodies& r = sim.model.rigid;
+  const double area = 1.0 - 0.4 * 0.5, weight = 2000.0 * area * 9.81;
+  EXPECT_NEAR(r.cy0[0] - r.cy[0], weight / (kn * 0.6), 0.01 * weight / (kn * 0.6));
+  EXPECT_LT(std::abs(r.theta[0]), 1e-9);
+  EXPECT_LT(worst, 0.01);
+  fs::remove_all(dir);
+}
+
+// Quasi-static capacity of a b x h rigid block on a Winkler joint of stiffness kn (no
+// tension), loaded by its weight W and lambda W at its centroid, sticking (mu > lambda).
+// Tilted by phi about its right-hand corner, which sits delta below the ground, the block's
+// overlap with the ground is the triangle between the ground line, its base and its right
+// side: base from x_C - delta cot(phi) to x_C + delta tan(phi), depth delta at the corner
+// x_C. The joint's pressure kn d over it gives the vertical force
+//     N = kn delta^2 / (2 sin phi cos phi)
+// through its centroid G (x_C + delta (tan phi - cot phi) / 3, -delta / 3); the friction
+// force, also at G, takes the horizontal load. Equilibrium: N = W fixes delta, and the moment
+// of the loads about G vanishes, with the centroid at
+//     X_c = x_C - b/2 cos phi + h/2 sin phi,  Y_c = -delta + b/2 sin phi + h/2 cos phi:
+//     lambda(phi) = (x_G - X_c) / (Y_c - y_G)
+//                 = (delta (tan phi - cot phi) / 3 + b/2 cos phi - h/2 sin phi)
+//                   / (b/2 sin phi + h/2 cos phi - 2 delta / 3).
+// The capacity is the peak of lambda(phi) (the rigid block's b/h at kn -> infinity).
+double winkler_capacity(double b, double h, double weight, double kn) {
+  double best = 0.0;
+  for (double phi = 1e-7; phi < std::atan(b / h); phi *= 1.0005) {
+    const double delta = std::sqrt(2.0 * weight * std::sin(phi) * std::cos(phi) / kn);
+    if (delta / std::sin(phi) > b) continue;  // the whole base still presses
+    const double lam = (delta * (std::tan(phi) - 1.0 / std::tan(phi)) / 3.0 +
+                        0.5 * b * std::cos(phi) - 0.5 * h * std::sin(phi)) /
+                       (0.5 * b * std::sin(phi) + 0.5 * h * std::cos(phi) - 2.0 * delta / 3.0);
+    best = std::max(best, lam);
+  }
+  return best;
+}
+
+TEST(RigidContact, WinklerBlockReachesTheClosedFormCapacityOfItsContactStrip) {
+  const double b = 0.25, h = 1.0, weight = 2000.0 * b * h * 9.81;
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  for (const char* kn : {"1e8", "1e10", "1e12"}) {
+    const std::string deck =
+        "[model]\nkind = \"block\"\nwidth = 0.25\nheight = 1.0\n[material]\nmodel = \"rigid\"\n"
+        "[contact]\nfriction = 0.8\nnormal_stiffness = " +
+        std::string(kn) + "\n[capacity]\ntolerance = 0.002\n";
+    const CapacityResult r = find_capacity(parse_deck(deck, "test"), crit, 2, true);
+    ASSERT_TRUE(r.bracketed) << kn;
+    const double expected = winkler_capacity(b, h, weight, std::stod(kn));
+    std::printf("[winkler] kn %s: lambda* %.5f, closed form %.5f (rigid block %.5f)\n", kn,
+                r.lambda_star, expected, b / h);
+    EXPECT_NEAR(r.lambda_star, expected, 0.01 * expected) << kn;
+  }
+}
+
+}  // namespace
+}  // namespace voussoir
