@@ -31,9 +31,16 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
-SettledState settle(const Config& config, const TrialCriteria& crit, bool quiet) {
+SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) {
   const auto t0 = Clock::now();
   SettledState s;
+  // The quasi-static phases damp every motion themselves: rigid joints take no dashpot there
+  // unless the deck gives one (contact/joint_stiffness.hpp kRigidDefaultRestitution).
+  Config config = given;
+  if (crit.quasi_static && !config.contact.has("restitution")) {
+    config.contact.restitution = 1.0;
+    config.contact.given.push_back("restitution");
+  }
   s.sim = make_simulation(config);
   if (crit.quasi_static) {
     s.sim.ctx.local_damping = config.capacity.local_damping;

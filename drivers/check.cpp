@@ -128,8 +128,12 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   } else {
     std::printf("penalty     %.4g Pa\n", info.penalty);
   }
-  if (config.contact.restitution < 1.0)
-    std::printf("restitution %.3g (impact damping)\n", config.contact.restitution);
+  if (sim.contact.params().restitution < 1.0)
+    std::printf("restitution %.3g (impact damping%s)\n", sim.contact.params().restitution,
+                config.contact.has("restitution")
+                    ? ""
+                    : "; rigid blocks' default in the physical runs, none in the quasi-static "
+                      "capacity trials");
   std::printf("damping eta %.4g Pa s\n", info.eta);
 
   if (!common.json_path.empty()) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "contact/joint_stiffness.hpp"
 #include "core/cst.hpp"
 #include "core/rigid.hpp"
 #include "io/deck.hpp"
@@ -40,6 +41,7 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   cp.normal_stiffness = config.contact.normal_stiffness;
   cp.shear_stiffness = config.contact.shear_stiffness;
   cp.restitution = config.contact.restitution;
+  if (rigid && !config.contact.has("restitution")) cp.restitution = kRigidDefaultRestitution;
   // Rigid blocks with neither a stiffness nor a penalty given: kn = 100 E / L per joint (L:
   // its length; contact/joint_stiffness.hpp).
   if (rigid && !(cp.normal_stiffness > 0.0) && !config.contact.has("penalty") &&

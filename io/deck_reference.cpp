@@ -80,7 +80,8 @@ const std::map<std::string, std::string>& meanings() {
       {"contact.shear_stiffness", "joint shear stiffness ks (not given: kn / 4)"},
       {"contact.restitution",
        "impact restitution of rigid blocks (1: no impact damping; below 1 needs "
-       "material.model = \"rigid\")"},
+       "material.model = \"rigid\"; not given: 0.5 for rigid blocks in run, pulse, stability and "
+       "capacity --dynamic, none in the quasi-static capacity trials)"},
       // [solver]
       {"solver.dt", "time step: \"auto\" (stable limit x solver.dt_safety) or a value"},
       {"solver.dt_safety", "fraction of the stable time step that \"auto\" uses"},
