@@ -141,17 +141,32 @@ std::vector<std::vector<Index>> merged_triangles(const Model& model, Index b) {
 
 bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
                     bool with_energy) {
-  Pt buf[2][kMaxClipped];
+  return convex_overlap(p, nullptr, np, q, nullptr, nq, out, with_energy);
+}
+
+bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
+                    ConvexOverlap& out, bool with_energy) {
+  Pt buf[2][kMaxClipped], qv[kMaxClipped];
   std::uint8_t on[2][kMaxClipped];
   double d[kMaxClipped];
-  // Coordinates relative to P's first vertex: the sliver's sums then cancel less.
+  // Coordinates relative to P's first vertex, reference and displacement parts apart: a joint's
+  // two faces share their reference vertices, so a penetration of 1e-12 m is resolved to
+  // round-off of itself, not of the coordinates (rigid_contact.hpp, "Exactness").
   const double ox = p[0].x, oy = p[0].y;
+  const double oux = pu ? pu[0].x : 0.0, ouy = pu ? pu[0].y : 0.0;
   int n = np, cur = 0;
-  for (int k = 0; k < np; ++k) buf[0][k] = {p[k].x - ox, p[k].y - oy}, on[0][k] = kOnP;
+  for (int k = 0; k < np; ++k) {
+    buf[0][k] = {(p[k].x - ox) + (pu ? pu[k].x - oux : 0.0),
+                 (p[k].y - oy) + (pu ? pu[k].y - ouy : 0.0)};
+    on[0][k] = kOnP;
+  }
+  for (int j = 0; j < nq; ++j)
+    qv[j] = {(q[j].x - ox) + (qu ? qu[j].x - oux : 0.0),
+             (q[j].y - oy) + (qu ? qu[j].y - ouy : 0.0)};
   for (int j = 0; j < nq; ++j) {
     const int j1 = j + 1 < nq ? j + 1 : 0;
-    const double ax = q[j].x - ox, ay = q[j].y - oy;
-    const double ex = q[j1].x - q[j].x, ey = q[j1].y - q[j].y;
+    const double ax = qv[j].x, ay = qv[j].y;
+    const double ex = qv[j1].x - qv[j].x, ey = qv[j1].y - qv[j].y;
     bool all_in = true, all_out = true;
     const Pt* v = buf[cur];
     for (int k = 0; k < n; ++k) {
@@ -189,7 +204,7 @@ bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap&
   const double chord = std::sqrt(nx * nx + ny * ny);
   if (!(chord > 0.0)) return false;
   out.area = 0.5 * a2;
-  out.centroid = {ox + vx0 + mx / (3.0 * a2), oy + vy0 + my / (3.0 * a2)};
+  out.centroid = {ox + oux + vx0 + mx / (3.0 * a2), oy + ouy + vy0 + my / (3.0 * a2)};
   out.normal = {nx / chord, ny / chord};
   out.chord = chord;
   out.depth_sq = 0.0;
@@ -244,6 +259,7 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
   block_piece_.assign(1, 0);
   ref_x_.clear();
   ref_y_.clear();
+  ref_.clear();
   radius_.assign(nb, 0.0);
   longest_side_.assign(nb, 0.0);
   for (std::size_t b = 0; b < nb; ++b) {
@@ -267,6 +283,7 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
       for (const Vec2& v : piece) {
         ref_x_.push_back(v.x - origin.x);
         ref_y_.push_back(v.y - origin.y);
+        ref_.push_back(v);
       }
       piece_first_.push_back(Index(ref_x_.size()));
     }
@@ -276,7 +293,8 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
                                                    model.nodes.y0[i] - origin.y));
   }
   const std::size_t pieces = piece_first_.size() - 1;
-  world_.resize(ref_x_.size());
+  world_ = ref_;
+  disp_.assign(ref_.size(), Vec2{});
   box_lo_x_.assign(pieces, 0.0), box_lo_y_.assign(pieces, 0.0);
   box_hi_x_.assign(pieces, 0.0), box_hi_y_.assign(pieces, 0.0);
   // Fixed blocks' pieces stay where they are.
@@ -284,9 +302,8 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
     for (Index k = block_piece_[b]; k < block_piece_[b + 1]; ++k) {
       double lx = std::numeric_limits<double>::infinity(), ly = lx, hx = -lx, hy = -lx;
       for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v) {
-        world_[v] = {ref_x_[v], ref_y_[v]};
-        lx = std::min(lx, ref_x_[v]), hx = std::max(hx, ref_x_[v]);
-        ly = std::min(ly, ref_y_[v]), hy = std::max(hy, ref_y_[v]);
+        lx = std::min(lx, ref_[v].x), hx = std::max(hx, ref_[v].x);
+        ly = std::min(ly, ref_[v].y), hy = std::max(hy, ref_[v].y);
       }
       box_lo_x_[k] = lx, box_lo_y_[k] = ly, box_hi_x_[k] = hx, box_hi_y_[k] = hy;
     }
@@ -334,7 +351,7 @@ bool RigidContact::needs_detection(const Model& model) const {
   const std::size_t nb = model.blocks.size();
   for (std::size_t b = 0; b < nb; ++b) {
     if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
-    const double dx = r.cx[b] - ref_cx_[b], dy = r.cy[b] - ref_cy_[b];
+    const double dx = r.ux[b] - ref_ux_[b], dy = r.uy[b] - ref_uy_[b];
     const double moved = std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
     if (moved > half) return true;
   }
@@ -392,7 +409,7 @@ void RigidContact::detect(const Model& model) {
   apart_line_.assign(np, -1);
   slip_x_.swap(sx), slip_y_.swap(sy), last_w_.swap(w);
   pair_constants(model);
-  ref_cx_ = r.cx, ref_cy_ = r.cy, ref_theta_ = r.theta;
+  ref_ux_ = r.ux, ref_uy_ = r.uy, ref_theta_ = r.theta;
   detected_ = true;
   ++detections_;
 }
@@ -467,13 +484,17 @@ void RigidContact::world_pieces(const Model& model) {
   const std::size_t nb = model.blocks.size();
   for (std::size_t b = 0; b < nb; ++b) {
     if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
-    const double c = std::cos(r.theta[b]), s = std::sin(r.theta[b]);
-    const double cx = r.cx[b], cy = r.cy[b];
+    // Displacement of each vertex, u = (c - c0) + (R - I) r with cos - 1 = -2 sin^2(theta/2):
+    // small numbers computed to their own round-off.
+    const double half = std::sin(0.5 * r.theta[b]);
+    const double cm1 = -2.0 * half * half, s = std::sin(r.theta[b]);
+    const double ux = r.ux[b], uy = r.uy[b];
     for (Index k = block_piece_[b]; k < block_piece_[b + 1]; ++k) {
       double lx = std::numeric_limits<double>::infinity(), ly = lx, hx = -lx, hy = -lx;
       for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v) {
-        const double x = cx + c * ref_x_[v] - s * ref_y_[v];
-        const double y = cy + s * ref_x_[v] + c * ref_y_[v];
+        const Vec2 u{ux + cm1 * ref_x_[v] - s * ref_y_[v], uy + s * ref_x_[v] + cm1 * ref_y_[v]};
+        disp_[v] = u;
+        const double x = ref_[v].x + u.x, y = ref_[v].y + u.y;
         world_[v] = {x, y};
         lx = std::min(lx, x), hx = std::max(hx, x);
         ly = std::min(ly, y), hy = std::max(hy, y);
@@ -506,7 +527,8 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
       const int nq = piece_first_[j + 1] - piece_first_[j];
       if (single && apart_line_[p] >= 0 && separated_by(pv, np, qv, nq, apart_line_[p])) continue;
       ConvexOverlap o;
-      if (!convex_overlap(pv, np, qv, nq, o, energy)) {
+      if (!convex_overlap(&ref_[piece_first_[i]], &disp_[piece_first_[i]], np,
+                          &ref_[piece_first_[j]], &disp_[piece_first_[j]], nq, o, energy)) {
         if (single) apart_line_[p] = std::int16_t(separating_line(pv, np, qv, nq));
         continue;
       }
@@ -671,7 +693,7 @@ std::vector<T> take(const std::vector<char>& in, std::size_t& at) {
 std::vector<char> RigidContact::save_state() const {
   std::vector<char> out;
   put(out, std::vector<std::int64_t>{detected_ ? 1 : 0, detections_, active_});
-  put(out, ref_cx_), put(out, ref_cy_), put(out, ref_theta_);
+  put(out, ref_ux_), put(out, ref_uy_), put(out, ref_theta_);
   put(out, pair_a_), put(out, pair_b_);
   put(out, slip_x_), put(out, slip_y_), put(out, last_w_);
   put(out, damp_prev_), put(out, fric_prev_);
@@ -697,7 +719,9 @@ void RigidContact::restore_state(const Model& model, const std::vector<char>& by
       throw std::runtime_error("rigid contact state does not fit this model");
     // The last detection again, from the bodies' poses then: the same candidates and reference.
     Model at_detection = model;
-    at_detection.rigid.cx = cx, at_detection.rigid.cy = cy, at_detection.rigid.theta = th;
+    RigidBodies& r = at_detection.rigid;
+    r.ux = cx, r.uy = cy, r.theta = th;
+    for (std::size_t b = 0; b < nb; ++b) r.cx[b] = r.cx0[b] + r.ux[b], r.cy[b] = r.cy0[b] + r.uy[b];
     pair_a_.clear(), pair_b_.clear(), slip_x_.clear(), slip_y_.clear(), last_w_.clear();
     detect(at_detection);
     if (pair_a_ != pa || pair_b_ != pb)

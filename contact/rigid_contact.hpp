@@ -103,6 +103,10 @@ inline constexpr int kMaxPieceVertices = 16;
 // the energy is for the ledger, read at samples.
 bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
                     bool with_energy = true);
+// The same with each vertex given as a reference position plus a displacement (pu, qu; null:
+// none), which the kernel keeps apart until the differences are taken.
+bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
+                    ConvexOverlap& out, bool with_energy);
 
 // A side line of Q (0 <= line < nq) or of P (nq <= line < nq + np) with the other polygon
 // wholly outside it: the two are apart. separating_line returns the first such line or -1.
@@ -169,8 +173,10 @@ class RigidContact {
   // block b has pieces [block_piece_[b], block_piece_[b + 1]).
   std::vector<Index> piece_first_, block_piece_;
   std::vector<double> ref_x_, ref_y_;
-  // Current configuration (free blocks rewritten each step): vertices and piece boxes.
-  std::vector<Vec2> world_;
+  std::vector<Vec2> ref_;  // the same vertices' reference positions, as the model gives them
+  // Current configuration (free blocks rewritten each step): each vertex's displacement from
+  // its reference position, the sum, and the piece boxes.
+  std::vector<Vec2> disp_, world_;
   std::vector<double> box_lo_x_, box_lo_y_, box_hi_x_, box_hi_y_;  // per piece
   // Per block: farthest outline point from the reference centroid [m], longest side [m].
   std::vector<double> radius_, longest_side_;
@@ -186,7 +192,7 @@ class RigidContact {
   BroadPhase broad_;
   Nodes scratch_;
   std::vector<IndexPair> tri_pairs_;
-  std::vector<double> ref_cx_, ref_cy_, ref_theta_;  // body poses at the last detection
+  std::vector<double> ref_ux_, ref_uy_, ref_theta_;  // body poses at the last detection
   bool detected_ = false;
 
   // Candidate block pairs (a < b), sorted, with their constants and state.

@@ -127,6 +127,10 @@ struct Joint {
 struct RigidBodies {
   // hot, per block
   std::vector<double> cx, cy, theta;    // centroid [m], rotation [rad] from the reference
+  // displacement of the centroid from the reference one [m], the integrated state: c = c0 + u.
+  // A settle moves a block by 1e-12 m in steps of 1e-15 m, which c itself (1 m) rounds to
+  // 1e-16 m; u keeps them to its own round-off.
+  std::vector<double> ux, uy;
   std::vector<double> vx, vy, omega;    // half-step velocity [m/s], angular velocity [rad/s]
   std::vector<double> fx, fy, torque;   // force [N] and moment about the centroid [N m] of the step
   // cold, per block

@@ -25,7 +25,7 @@ void make_blocks_rigid(Model& model) {
   const Triangles& t = model.tris;
   RigidBodies& r = model.rigid;
   const std::size_t nb = model.blocks.size();
-  for (auto* v : {&r.cx, &r.cy, &r.theta, &r.vx, &r.vy, &r.omega, &r.fx, &r.fy, &r.torque, &r.cx0,
+  for (auto* v : {&r.cx, &r.cy, &r.ux, &r.uy, &r.theta, &r.vx, &r.vy, &r.omega, &r.fx, &r.fy, &r.torque, &r.cx0,
                   &r.cy0, &r.mass, &r.inertia, &r.load_mass})
     v->assign(nb, 0.0);
   r.rx.assign(n.x.size(), 0.0);
@@ -66,6 +66,7 @@ void set_rigid_state(Model& model, Index b, double cx, double cy, double theta, 
   Nodes& n = model.nodes;
   const Block& blk = model.blocks[std::size_t(b)];
   r.cx[b] = cx, r.cy[b] = cy, r.theta[b] = theta;
+  r.ux[b] = cx - r.cx0[b], r.uy[b] = cy - r.cy0[b];
   r.vx[b] = vx, r.vy[b] = vy, r.omega[b] = omega;
   const double cs = std::cos(theta), sn = std::sin(theta);
   for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
@@ -107,8 +108,10 @@ double update_rigid_bodies(Model& model, double dt, double alpha, bool outgoing,
     r.vx[b] = ux;
     r.vy[b] = uy;
     r.omega[b] = w;
-    r.cx[b] += dt * ux;
-    r.cy[b] += dt * uy;
+    r.ux[b] += dt * ux;
+    r.uy[b] += dt * uy;
+    r.cx[b] = r.cx0[b] + r.ux[b];
+    r.cy[b] = r.cy0[b] + r.uy[b];
     r.theta[b] += dt * w;
   }
   return 0.5 * twice_kinetic;
@@ -160,8 +163,10 @@ void reset_rigid_step(Model& model, double dt) {
   RigidBodies& r = model.rigid;
   for (std::size_t b = 0; b < model.blocks.size(); ++b) {
     if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
-    r.cx[b] -= dt * r.vx[b];
-    r.cy[b] -= dt * r.vy[b];
+    r.ux[b] -= dt * r.vx[b];
+    r.uy[b] -= dt * r.vy[b];
+    r.cx[b] = r.cx0[b] + r.ux[b];
+    r.cy[b] = r.cy0[b] + r.uy[b];
     r.theta[b] -= dt * r.omega[b];
     r.vx[b] = r.vy[b] = r.omega[b] = 0.0;
   }

@@ -25,9 +25,10 @@ namespace {
 constexpr char kMagic[] = "VOUSSOIR-CKPT\n";  // 14 characters, no terminator written
 constexpr std::size_t kMagicSize = sizeof(kMagic) - 1;
 // Version 2 adds the impact damping's dissipation to the ledger and the rigid bodies' state
-// (centroid, rotation, velocities: empty arrays for elastic blocks); version 1 files (elastic
-// runs of earlier builds) are still read.
-constexpr std::uint32_t kVersion = 2;
+// (empty arrays for elastic blocks); version 3 writes the bodies' centroid displacements
+// instead of their centroids, and the outline contact's state for rigid blocks. Version 1 and
+// 2 files of elastic runs are still read; rigid ones of version 2 are refused.
+constexpr std::uint32_t kVersion = 3;
 constexpr std::uint32_t kByteOrderTag = 0x01020304u;
 // Contact kind byte: 1 = ContactSystem::save_state bytes follow. (0 was written by builds
 // without that interface, frictionless runs only; such files are refused.)
@@ -160,7 +161,7 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
   o.array(n.vy);
   o.array(sim.viscous_piola);
   const RigidBodies& r = sim.model.rigid;
-  for (const auto* v : {&r.cx, &r.cy, &r.theta, &r.vx, &r.vy, &r.omega}) o.array(*v);
+  for (const auto* v : {&r.ux, &r.uy, &r.theta, &r.vx, &r.vy, &r.omega}) o.array(*v);
   o.value<std::uint8_t>(kContactBytes);
   o.array(sim.contact.save_state());
   o.array(driver_state);
@@ -192,8 +193,8 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   if (stored_sum != sum.h) in.fail("checksum mismatch (truncated or corrupt)");
   in.pos = kMagicSize;
   const auto version = in.value<std::uint32_t>();
-  if (version != kVersion && version != 1)
-    in.fail("format version " + std::to_string(version) + ", this program reads versions 1 and " +
+  if (version != kVersion && version != 1 && version != 2)
+    in.fail("format version " + std::to_string(version) + ", this program reads versions 1 to " +
             std::to_string(kVersion));
   if (in.value<std::uint32_t>() != kByteOrderTag)
     in.fail("written on a machine of another byte order");
@@ -251,8 +252,11 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
       in.fail(bodies == 0 ? "written for rigid blocks, this model's are elastic"
                           : "rigid body count differs from the model");
   if (bodies > 0) {
-    r.cx = rigid[0], r.cy = rigid[1], r.theta = rigid[2];
+    if (version < 3) in.fail("written for rigid blocks by a build before their outline contact");
+    r.ux = rigid[0], r.uy = rigid[1], r.theta = rigid[2];
     r.vx = rigid[3], r.vy = rigid[4], r.omega = rigid[5];
+    for (std::size_t b = 0; b < bodies; ++b)
+      r.cx[b] = r.cx0[b] + r.ux[b], r.cy[b] = r.cy0[b] + r.uy[b];
   }
   try {
     sim.contact.restore_state(sim.model, contact);

@@ -478,7 +478,8 @@ TEST(Direction, BothReportsEachDirectionAndTheSmaller) {
 TEST(MassScaling, EveryBlockReachesTheStepAndTheCapacityStays) {
   const fs::path dir = fs::temp_directory_path() / "voussoir_mass_scaling";
   fs::create_directories(dir);
-  const Config deck = polygon_deck(dir, 1.0);
+  // Undamped joints, as the quasi-static phases take them (drivers/capacity.cpp settle).
+  const Config deck = polygon_deck(dir, 1.0, {"contact.restitution=1"});
   Simulation sim = make_simulation(deck);
   const std::vector<double> before = rigid_body_stable_steps(sim);
   const double dt_before = stable_time_step(sim);

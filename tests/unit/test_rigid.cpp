@@ -207,7 +207,7 @@ TEST(Rigid, CheckpointFingerprintTellsJointsApart) {
   const std::string deck = block_deck("friction = 0.8\nnormal_stiffness = 1e10");
   const Simulation a = deck_sim(deck);
   const Simulation b = deck_sim(deck, {"contact.normal_stiffness=2e10"});
-  const Simulation c = deck_sim(deck, {"contact.restitution=0.5"});
+  const Simulation c = deck_sim(deck, {"contact.restitution=0.3"});
   const Simulation d = deck_sim(deck, {"contact.shear_stiffness=1e9"});
   const std::uint64_t fa = simulation_fingerprint(a, 0.8);
   for (const Simulation* other : {&b, &c, &d}) EXPECT_NE(simulation_fingerprint(*other, 0.8), fa);
@@ -369,11 +369,16 @@ TEST(Rigid, StableStepIsSetByTheJointsNotTheElements) {
       "voussoirs = 11\n";
   deck_sim(arch, {}, &elastic);
   // Engineering joints (1e10 N/m3) against the elements and penalty of elastic blocks.
-  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e10"}, &soft);
+  // Undamped joints (rigid blocks' default restitution is 0.5, contact/joint_stiffness.hpp).
+  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e10", "contact.restitution=1"},
+           &soft);
   EXPECT_GT(soft.dt, 10.0 * elastic.dt);
   // kn sets it: a 100 x stiffer joint, a 10 x shorter step.
-  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e12"}, &stiff);
-  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e14"}, &stiffer);
+  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e12", "contact.restitution=1"},
+           &stiff);
+  deck_sim(arch,
+           {"material.model=rigid", "contact.normal_stiffness=1e14", "contact.restitution=1"},
+           &stiffer);
   EXPECT_NEAR(stiff.dt / stiffer.dt, 10.0, 0.01);
   EXPECT_NE(soft.dt_set_by.find("rigid"), std::string::npos);
   // Impact damping keeps the finer fraction of 2 / omega (core/rigid.hpp), and the dashpot's
