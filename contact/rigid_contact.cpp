@@ -154,6 +154,54 @@ std::vector<std::vector<Index>> merged_triangles(const Model& model, Index b) {
 
 }  // namespace
 
+namespace {
+
+// The clipping stage of convex_overlap: O = P n Q in coordinates relative to P's first vertex
+// (ox, oy plus its displacement), into buf[cur] and on[cur]; returns O's vertex count (< 3: no
+// overlap) and sets cur. kDisp: the vertices carry displacements pu, qu.
+template <bool kDisp>
+int clip_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
+                 Pt (&buf)[2][kMaxClipped], std::uint8_t (&on)[2][kMaxClipped], int& cur) {
+  Pt qv[kMaxClipped];
+  double d[kMaxClipped];
+  // Coordinates relative to P's first vertex, reference and displacement parts apart: a joint's
+  // two faces share their reference vertices, so a penetration of 1e-12 m is resolved to
+  // round-off of itself, not of the coordinates (rigid_contact.hpp, "Exactness").
+  const double ox = p[0].x, oy = p[0].y;
+  const double oux = kDisp ? pu[0].x : 0.0, ouy = kDisp ? pu[0].y : 0.0;
+  for (int k = 0; k < np; ++k) {
+    buf[0][k] = {(p[k].x - ox) + (kDisp ? pu[k].x - oux : 0.0),
+                 (p[k].y - oy) + (kDisp ? pu[k].y - ouy : 0.0)};
+    on[0][k] = kOnP;
+  }
+  for (int j = 0; j < nq; ++j)
+    qv[j] = {(q[j].x - ox) + (kDisp ? qu[j].x - oux : 0.0),
+             (q[j].y - oy) + (kDisp ? qu[j].y - ouy : 0.0)};
+  int n = np;
+  cur = 0;
+  for (int j = 0; j < nq; ++j) {
+    const int j1 = j + 1 < nq ? j + 1 : 0;
+    const double ax = qv[j].x, ay = qv[j].y;
+    const double ex = qv[j1].x - ax, ey = qv[j1].y - ay;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    const Pt* v = buf[cur];
+    for (int k = 0; k < n; ++k) {
+      // Differences first: a vertex near the line gets its distance to its own round-off.
+      d[k] = ex * (v[k].y - ay) - ey * (v[k].x - ax);
+      lo = std::min(lo, d[k]);
+      hi = std::max(hi, d[k]);
+    }
+    if (hi < 0.0) return 0;  // P wholly outside this side of Q
+    if (lo >= 0.0) continue;  // wholly inside: nothing to cut
+    n = clip_by_line(buf[cur], on[cur], n, d, buf[1 - cur], on[1 - cur]);
+    cur = 1 - cur;
+    if (n < 3) return 0;
+  }
+  return n;
+}
+
+}  // namespace
+
 bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
                     bool with_energy) {
   return convex_overlap(p, nullptr, np, q, nullptr, nq, out, with_energy);
@@ -161,46 +209,21 @@ bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap&
 
 bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
                     ConvexOverlap& out, bool with_energy) {
-  Pt buf[2][kMaxClipped], qv[kMaxClipped];
+  Pt buf[2][kMaxClipped];
   std::uint8_t on[2][kMaxClipped];
-  double d[kMaxClipped];
-  // Coordinates relative to P's first vertex, reference and displacement parts apart: a joint's
-  // two faces share their reference vertices, so a penetration of 1e-12 m is resolved to
-  // round-off of itself, not of the coordinates (rigid_contact.hpp, "Exactness").
-  const double ox = p[0].x, oy = p[0].y;
-  const double oux = pu ? pu[0].x : 0.0, ouy = pu ? pu[0].y : 0.0;
-  int n = np, cur = 0;
-  for (int k = 0; k < np; ++k) {
-    buf[0][k] = {(p[k].x - ox) + (pu ? pu[k].x - oux : 0.0),
-                 (p[k].y - oy) + (pu ? pu[k].y - ouy : 0.0)};
-    on[0][k] = kOnP;
-  }
-  for (int j = 0; j < nq; ++j)
-    qv[j] = {(q[j].x - ox) + (qu ? qu[j].x - oux : 0.0),
-             (q[j].y - oy) + (qu ? qu[j].y - ouy : 0.0)};
-  for (int j = 0; j < nq; ++j) {
-    const int j1 = j + 1 < nq ? j + 1 : 0;
-    const double ax = qv[j].x, ay = qv[j].y;
-    const double ex = qv[j1].x - qv[j].x, ey = qv[j1].y - qv[j].y;
-    bool all_in = true, all_out = true;
-    const Pt* v = buf[cur];
-    for (int k = 0; k < n; ++k) {
-      d[k] = ex * (v[k].y - ay) - ey * (v[k].x - ax);
-      all_in = all_in && d[k] >= 0.0;
-      all_out = all_out && d[k] < 0.0;
-    }
-    if (all_out) return false;
-    if (all_in) continue;
-    n = clip_by_line(buf[cur], on[cur], n, d, buf[1 - cur], on[1 - cur]);
-    cur = 1 - cur;
-    if (n < 3) return false;
-  }
+  int cur = 0;
+  const int n = pu && qu ? clip_overlap<true>(p, pu, np, q, qu, nq, buf, on, cur)
+                         : clip_overlap<false>(p, pu, np, q, qu, nq, buf, on, cur);
+  if (n < 3) return false;
+  const double ox = p[0].x + (pu && qu ? pu[0].x : 0.0);
+  const double oy = p[0].y + (pu && qu ? pu[0].y : 0.0);
   const Pt* v = buf[cur];
   const std::uint8_t* lab = on[cur];
   // Area and first moment about O's first vertex (Green's theorem: a sliver's terms are then
   // each of its own size), and P's outward normals times lengths.
   const double vx0 = v[0].x, vy0 = v[0].y;
-  double a2 = 0.0, mx = 0.0, my = 0.0, npx = 0.0, npy = 0.0, nqx = 0.0, nqy = 0.0;
+  // n = (N_P - N_Q) / 2: P's edges count +1/2, Q's -1/2.
+  double a2 = 0.0, mx = 0.0, my = 0.0, nx = 0.0, ny = 0.0;
   for (int k = 0; k < n; ++k) {
     const int k1 = k + 1 < n ? k + 1 : 0;
     const double x0 = v[k].x - vx0, y0 = v[k].y - vy0, x1 = v[k1].x - vx0, y1 = v[k1].y - vy0;
@@ -208,19 +231,16 @@ bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const 
     a2 += c;
     mx += (x0 + x1) * c;
     my += (y0 + y1) * c;
-    if (lab[k] == kOnP) {
-      npx += y1 - y0, npy -= x1 - x0;
-    } else {
-      nqx += y1 - y0, nqy -= x1 - x0;
-    }
+    const double w = lab[k] == kOnP ? 0.5 : -0.5;
+    nx += w * (y1 - y0);
+    ny -= w * (x1 - x0);
   }
   if (!(a2 > 0.0)) return false;
-  const double nx = 0.5 * (npx - nqx), ny = 0.5 * (npy - nqy);
   const double chord = std::sqrt(nx * nx + ny * ny);
   if (!(chord > 0.0)) return false;
   out.area = 0.5 * a2;
   const double third = 1.0 / (3.0 * a2), inv_chord = 1.0 / chord;
-  out.centroid = {ox + oux + vx0 + mx * third, oy + ouy + vy0 + my * third};
+  out.centroid = {ox + vx0 + mx * third, oy + vy0 + my * third};
   out.normal = {nx * inv_chord, ny * inv_chord};
   out.chord = chord;
   out.depth_sq = 0.0;

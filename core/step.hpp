@@ -2,12 +2,14 @@
 // One explicit step (STYLE.md "The step is one short function"): advance() calls the stages
 // in order, each stage reads the per-step context, no stage calls another, no I/O.
 //
-//   1. broad phase if some node moved more than the buffer allows
-//   2. clear forces
-//   3. element forces (finite-strain CST + Munjiza damping)      core/cst
-//   4. contact forces (potential penalty + Coulomb friction)       contact/
-//   5. body loads (gravity, lambda g, base motion)                 core/loads
-//   6. central-difference integration (v then x), kinetic energy   core/integrate
+//   1. broad phase if some node (rigid blocks: some outline point) moved more than the buffer
+//      allows
+//   2. clear forces (of the nodes, or of the rigid bodies)
+//   3. element forces (finite-strain CST + Munjiza damping)      core/cst; none for rigid blocks
+//   4. contact forces (potential penalty, or the rigid blocks'     contact/
+//      joint law between outlines, + Coulomb friction)
+//   5. body loads (gravity, lambda g, base motion)                 core/loads, core/rigid
+//   6. central-difference integration (v then x), kinetic energy   core/integrate, core/rigid
 //      (with the local damping of the quasi-static phases when ctx.local_damping > 0, and
 //      their kinetic damping when ctx.kinetic_damping > 0)
 

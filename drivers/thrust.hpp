@@ -5,7 +5,10 @@
 // Source of the forces. ContactSystem::pair_forces evaluates every touching triangle pair at
 // the current node positions and velocities on a copy of the contact system: the nodal forces
 // (potential penalty, friction and impact damping) that the contact stage applies, without
-// touching the run's state, its forces or the order of any sum in the step.
+// touching the run's state, its forces or the order of any sum in the step. Rigid blocks touch
+// by their outlines: ContactSystem::block_pair_forces gives each touching block pair's force
+// on its second block and the moment of it, the very force and moment that body gets, and the
+// resultant below takes them as they are (their moment moved to O).
 //
 // Resultant of joint j between blocks A = block_a and B = block_b. The pairs between A and B
 // give nodal forces on both blocks; their totals are equal and opposite, their moments differ
