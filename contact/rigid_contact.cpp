@@ -90,7 +90,7 @@ inline void half_angle(double theta, double& s, double& c) {
   if (std::abs(x) < 0.01) {
     const double x2 = x * x;
     s = x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))));
-    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 - x2 / 3628800))));
+    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 - x2 * (1.0 / 3628800)))));
   } else {
     s = std::sin(x);
     c = std::cos(x);
@@ -417,15 +417,23 @@ void RigidContact::detect(const Model& model) {
   }
   std::sort(next.begin(), next.end());
   next.erase(std::unique(next.begin(), next.end()), next.end());
-  // Keep the pairs whose outlines are within the buffer of each other: until the next
-  // detection every outline point moves by at most buffer / 2, so the others stay apart.
+  // Keep the pairs whose outlines are within the buffer of each other, and of each the pairs of
+  // convex pieces that are: until the next detection every outline point moves by at most
+  // buffer / 2, so the others stay apart.
   world_pieces(model);
   const double reach = broad_.buffer();
-  next.erase(std::remove_if(next.begin(), next.end(),
-                            [&](const std::pair<Index, Index>& ab) {
-                              return !(outline_gap(ab.first, ab.second) <= reach);
-                            }),
-             next.end());
+  std::vector<std::pair<Index, Index>> kept;
+  std::vector<Index> live_first{0}, live_i, live_j;
+  for (const auto& [a, b] : next) {
+    for (Index i = block_piece_[a]; i < block_piece_[a + 1]; ++i)
+      for (Index j = block_piece_[b]; j < block_piece_[b + 1]; ++j)
+        if (piece_gap(i, j) <= reach) live_i.push_back(i), live_j.push_back(j);
+    if (Index(live_i.size()) == live_first.back()) continue;
+    kept.push_back({a, b});
+    live_first.push_back(Index(live_i.size()));
+  }
+  next.swap(kept);
+  live_first_.swap(live_first), live_i_.swap(live_i), live_j_.swap(live_j);
   // Carry the friction slip and the dashpot's last wrench by the block pair.
   const std::size_t np = next.size();
   std::vector<Index> na(np), nbk(np);
@@ -442,7 +450,7 @@ void RigidContact::detect(const Model& model) {
     }
   }
   pair_a_.swap(na), pair_b_.swap(nbk);
-  apart_line_.assign(np, -1);
+  apart_line_.assign(live_i_.size(), -1);
   slip_x_.swap(sx), slip_y_.swap(sy), last_w_.swap(w);
   pair_constants(model);
   ref_ux_ = r.ux, ref_uy_ = r.uy, ref_theta_ = r.theta;
@@ -450,22 +458,19 @@ void RigidContact::detect(const Model& model) {
   ++detections_;
 }
 
-// Smallest distance between the outlines of blocks a and b at the current configuration (0 when
-// they overlap) [m].
-double RigidContact::outline_gap(Index a, Index b) const {
+// Smallest distance between convex pieces i and j at the current configuration (0 when they
+// overlap) [m].
+double RigidContact::piece_gap(Index i, Index j) const {
+  const Vec2* p = &world_[piece_first_[i]];
+  const Vec2* q = &world_[piece_first_[j]];
+  const int np = piece_first_[i + 1] - piece_first_[i];
+  const int nq = piece_first_[j + 1] - piece_first_[j];
+  if (separating_line(p, np, q, nq) < 0) return 0.0;  // convex pieces not apart: overlap
   double gap = std::numeric_limits<double>::infinity();
-  for (Index i = block_piece_[a]; i < block_piece_[a + 1]; ++i)
-    for (Index j = block_piece_[b]; j < block_piece_[b + 1]; ++j) {
-      const Vec2* p = &world_[piece_first_[i]];
-      const Vec2* q = &world_[piece_first_[j]];
-      const int np = piece_first_[i + 1] - piece_first_[i];
-      const int nq = piece_first_[j + 1] - piece_first_[j];
-      if (separating_line(p, np, q, nq) < 0) return 0.0;  // convex pieces not apart: overlap
-      for (int k = 0; k < np; ++k)
-        for (int l = 0; l < nq; ++l) {
-          gap = std::min(gap, distance_to_segment(p[k], q[l], q[l + 1 < nq ? l + 1 : 0]));
-          gap = std::min(gap, distance_to_segment(q[l], p[k], p[k + 1 < np ? k + 1 : 0]));
-        }
+  for (int k = 0; k < np; ++k)
+    for (int l = 0; l < nq; ++l) {
+      gap = std::min(gap, distance_to_segment(p[k], q[l], q[l + 1 < nq ? l + 1 : 0]));
+      gap = std::min(gap, distance_to_segment(q[l], p[k], p[k + 1 < np ? k + 1 : 0]));
     }
   return gap;
 }
@@ -551,10 +556,8 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
   Vec2 force;
   double mb = 0.0, ma = 0.0;
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
-  const bool single = block_piece_[a + 1] - block_piece_[a] == 1 &&
-                      block_piece_[b + 1] - block_piece_[b] == 1;
-  for (Index i = block_piece_[a]; i < block_piece_[a + 1]; ++i)
-    for (Index j = block_piece_[b]; j < block_piece_[b + 1]; ++j) {
+  for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
+      const Index i = live_i_[live], j = live_j_[live];
       if (box_lo_x_[i] > box_hi_x_[j] || box_lo_x_[j] > box_hi_x_[i] ||
           box_lo_y_[i] > box_hi_y_[j] || box_lo_y_[j] > box_hi_y_[i])
         continue;
@@ -562,11 +565,12 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
       const Vec2* qv = &world_[piece_first_[j]];
       const int np = piece_first_[i + 1] - piece_first_[i];
       const int nq = piece_first_[j + 1] - piece_first_[j];
-      if (single && apart_line_[p] >= 0 && separated_by(pv, np, qv, nq, apart_line_[p])) continue;
+      std::int16_t& apart = apart_line_[live];
+      if (apart >= 0 && separated_by(pv, np, qv, nq, apart)) continue;
       ConvexOverlap o;
       if (!convex_overlap(&ref_[piece_first_[i]], &disp_[piece_first_[i]], np,
                           &ref_[piece_first_[j]], &disp_[piece_first_[j]], nq, o, energy)) {
-        if (single) apart_line_[p] = std::int16_t(separating_line(pv, np, qv, nq));
+        apart = std::int16_t(separating_line(pv, np, qv, nq));
         continue;
       }
       const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b

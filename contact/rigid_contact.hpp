@@ -158,7 +158,7 @@ class RigidContact {
     Vec2 point;              // G
   };
   void world_pieces(const Model& model);
-  double outline_gap(Index a, Index b) const;
+  double piece_gap(Index i, Index j) const;
   bool evaluate(std::size_t p, const Model& model, double dt, bool energy, PairOut& out);
   void pair_constants(const Model& model);
 
@@ -200,9 +200,12 @@ class RigidContact {
   std::vector<double> kn_t_, kt_, beta_;       // [N/m2], [N/m], [s]
   std::vector<double> slip_x_, slip_y_;        // friction state [m]
   std::vector<double> last_w_;                 // 4 per pair: F_x, F_y, M_b, M_a of the last step
-  // Per pair of one-piece blocks, a side line that separated them at the last evaluation, or -1
-  // (separated_by's numbering): tried first, it rejects a pair that is still apart in O(n).
-  // Not state: it only skips work whose answer is "apart".
+  // The pairs of convex pieces of each candidate pair that were within the buffer at the
+  // detection (pair p's: [live_first_[p], live_first_[p + 1]) of live_i_, live_j_), and for
+  // each a side line that separated them at the last evaluation, or -1 (separated_by's
+  // numbering): tried first, it rejects two pieces that are still apart in O(n). The line is
+  // not state: it only skips work whose answer is "apart".
+  std::vector<Index> live_first_, live_i_, live_j_;
   std::vector<std::int16_t> apart_line_;
 
   // Ledger: per body (3 values: x, y, rotation) the dashpot and friction forces of this and of

@@ -16,7 +16,9 @@
 #include "core/rigid.hpp"
 #include "core/step.hpp"
 #include "drivers/capacity.hpp"
+#include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/thrust.hpp"
 #include "io/deck.hpp"
 
 namespace voussoir {
@@ -196,6 +198,31 @@ TEST(RigidContact, WinklerBlockReachesTheClosedFormCapacityOfItsContactStrip) {
     std::printf("[winkler] kn %s: lambda* %.5f, closed form %.5f (rigid block %.5f)\n", kn,
                 r.lambda_star, expected, b / h);
     EXPECT_NEAR(r.lambda_star, expected, 0.01 * expected) << kn;
+  }
+}
+
+// The shipped semicircular arch run for 0.3 s with the rigid blocks' default joint damping: the
+// springings carry the arch's weight, and the mirror joints carry mirror thrusts (the deck is
+// symmetric). Undamped joints ring on and miss both (docs/rigid.md, "Joint damping by default").
+TEST(RigidContact, ShippedArchRunEndsInStaticEquilibrium) {
+  const Config config = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml",
+                                  {"solver.end_time=0.3"});
+  Simulation sim = make_simulation(config);
+  run_loop(sim, 0.3, 1e-3, [](const Simulation&) { return true; }, true, "arch");
+  const std::vector<JointResultant> joints = joint_resultants(sim.model, sim.contact, sim.ctx.dt);
+  const std::size_t nj = joints.size();
+  ASSERT_EQ(nj, 12u);
+  double weight = 0.0;
+  for (const Block& b : sim.model.blocks)
+    if (!b.fixed) weight += b.mass * config.load.gravity;
+  // Joints 0 and nj - 1 are the springings (on the abutments); their vertical forces carry it.
+  const double carried = std::abs(joints.front().force.y) + std::abs(joints.back().force.y);
+  EXPECT_NEAR(carried, weight, 0.01 * weight);
+  for (std::size_t j = 0; j < nj / 2; ++j) {
+    const JointResultant &left = joints[j], &right = joints[nj - 1 - j];
+    ASSERT_TRUE(left.closed && right.closed) << "joint " << j;
+    EXPECT_NEAR(left.eccentricity, right.eccentricity, 0.01) << "joints " << j << ", " << nj - 1 - j;
+    EXPECT_NEAR(left.normal_force, right.normal_force, 1e-3 * weight) << "joint " << j;
   }
 }
 
