@@ -67,12 +67,21 @@ struct FrictionResult {
 // One friction update. normal_force: pair potential force on c [N]; du: relative displacement
 // increment of c w.r.t. t at the contact point [m]; slip: elastic slip s before the step [m];
 // kt [N/m] > 0; mu >= 0.
+inline FrictionResult coulomb_friction(double fn, Vec2 unit_normal, Vec2 du, Vec2 slip, double kt,
+                                       double mu);
+
 inline FrictionResult coulomb_friction(Vec2 normal_force, Vec2 du, Vec2 slip, double kt,
                                        double mu) {
-  FrictionResult r;
   const double fn = std::sqrt(normal_force.x * normal_force.x + normal_force.y * normal_force.y);
-  if (!(fn > 0.0)) return r;
-  const double ex = -normal_force.y / fn, ey = normal_force.x / fn;
+  if (!(fn > 0.0)) return FrictionResult{};
+  return coulomb_friction(fn, Vec2{normal_force.x / fn, normal_force.y / fn}, du, slip, kt, mu);
+}
+
+// The same with the normal force given as its magnitude fn > 0 and unit direction (on c).
+inline FrictionResult coulomb_friction(double fn, Vec2 unit_normal, Vec2 du, Vec2 slip, double kt,
+                                       double mu) {
+  FrictionResult r;
+  const double ex = -unit_normal.y, ey = unit_normal.x;
   const double s_trial = (slip.x + du.x) * ex + (slip.y + du.y) * ey;
   const double cap = mu * fn;
   double s = s_trial, f = -kt * s_trial;

@@ -553,7 +553,8 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
   const RigidBodies& r = model.rigid;
   const Index a = pair_a_[p], b = pair_b_[p];
   double area = 0.0, energy2 = 0.0, gx = 0.0, gy = 0.0;
-  Vec2 force;
+  Vec2 force, unit;  // unit: the one overlap's normal
+  int regions = 0;
   double mb = 0.0, ma = 0.0;
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
@@ -578,6 +579,8 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
       mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
       ma -= (o.centroid.x - ca_x) * f.y - (o.centroid.y - ca_y) * f.x;
       area += o.area;
+      unit = o.normal;
+      ++regions;
       gx += o.area * o.centroid.x, gy += o.area * o.centroid.y;
       energy2 += o.depth_sq;
     }
@@ -600,7 +603,11 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
     const double ub_x = r.vx[b] - r.omega[b] * (g.y - cb_y), ub_y = r.vy[b] + r.omega[b] * (g.x - cb_x);
     const double ua_x = r.vx[a] - r.omega[a] * (g.y - ca_y), ua_y = r.vy[a] + r.omega[a] * (g.x - ca_x);
     const Vec2 du{dt * (ub_x - ua_x), dt * (ub_y - ua_y)};
-    const FrictionResult fr = coulomb_friction(force, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_);
+    // One overlap (a joint): its force kn |O| along its normal, no square root to take again.
+    const FrictionResult fr =
+        regions == 1
+            ? coulomb_friction(kn_t_[p] * area, unit, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_)
+            : coulomb_friction(force, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_);
     slip_x_[p] = fr.slip.x, slip_y_[p] = fr.slip.y;
     out.stored = fr.stored;
     out.fric_b = fr.force;
