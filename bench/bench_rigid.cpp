@@ -50,8 +50,12 @@ void step_church(benchmark::State& state, const std::string& name) {
   state.counters["active"] = static_cast<double>(sim.contact.active_pairs());
 }
 
-void BM_StepChurchB(benchmark::State& state) { step_church(state, "church_b"); }
-void BM_StepChurchA(benchmark::State& state) { step_church(state, "church_a"); }
+void BM_StepChurchB(benchmark::State& state) {
+  step_church(state, "church_b");
+}
+void BM_StepChurchA(benchmark::State& state) {
+  step_church(state, "church_a");
+}
 
 }  // namespace
 

@@ -903,8 +903,7 @@ void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger, bo
        : s.accumulate<false, false>(model, dt, ledger);
 }
 
-std::vector<BlockPairForce> ContactSystem::block_pair_forces(const Model& model,
-                                                            double dt) const {
+std::vector<BlockPairForce> ContactSystem::block_pair_forces(const Model& model, double dt) const {
   if (!impl_->ready || !impl_->rigid_mode) return {};
   return impl_->rigid.pair_forces(model, dt);
 }

@@ -90,7 +90,8 @@ inline void half_angle(double theta, double& s, double& c) {
   if (std::abs(x) < 0.01) {
     const double x2 = x * x;
     s = x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))));
-    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 - x2 * (1.0 / 3628800)))));
+    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 +
+                                 x2 * (-1.0 / 720 + x2 * (1.0 / 40320 - x2 * (1.0 / 3628800)))));
   } else {
     s = std::sin(x);
     c = std::cos(x);
@@ -137,7 +138,8 @@ std::vector<std::vector<Index>> merged_triangles(const Model& model, Index b) {
             if (pj[kj] != v || pj[(kj + 1) % pj.size()] != u) continue;
             // i from v round to u, then j's vertices strictly between u and v.
             std::vector<Index> joined;
-            for (std::size_t s = 0; s < pi.size(); ++s) joined.push_back(pi[(ki + 1 + s) % pi.size()]);
+            for (std::size_t s = 0; s < pi.size(); ++s)
+              joined.push_back(pi[(ki + 1 + s) % pi.size()]);
             for (std::size_t s = 2; s < pj.size(); ++s) joined.push_back(pj[(kj + s) % pj.size()]);
             if (int(joined.size()) <= kMaxPieceVertices && is_convex(points(joined))) {
               pieces[i] = joined;
@@ -191,7 +193,7 @@ int clip_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec
       lo = std::min(lo, d[k]);
       hi = std::max(hi, d[k]);
     }
-    if (hi < 0.0) return 0;  // P wholly outside this side of Q
+    if (hi < 0.0) return 0;   // P wholly outside this side of Q
     if (lo >= 0.0) continue;  // wholly inside: nothing to cut
     n = clip_by_line(buf[cur], on[cur], n, d, buf[1 - cur], on[1 - cur]);
     cur = 1 - cur;
@@ -325,8 +327,8 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
     }
     block_piece_.push_back(Index(piece_first_.size() - 1));
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i)
-      radius_[b] = std::max(radius_[b], std::hypot(model.nodes.x0[i] - origin.x,
-                                                   model.nodes.y0[i] - origin.y));
+      radius_[b] = std::max(radius_[b],
+                            std::hypot(model.nodes.x0[i] - origin.x, model.nodes.y0[i] - origin.y));
   }
   const std::size_t pieces = piece_first_.size() - 1;
   world_ = ref_;
@@ -388,7 +390,8 @@ bool RigidContact::needs_detection(const Model& model) const {
   for (std::size_t b = 0; b < nb; ++b) {
     if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
     const double dx = r.ux[b] - ref_ux_[b], dy = r.uy[b] - ref_uy_[b];
-    const double moved = std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
+    const double moved =
+        std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
     if (moved > half) return true;
   }
   return false;
@@ -496,7 +499,8 @@ void RigidContact::pair_constants(const Model& model) {
     const Block& second = ba.fixed ? ba : bb;
     double kn = kn_given_;
     if (!(kn > 0.0) && young_ > 0.0) {
-      kn = joint ? default_joint_stiffness(young_, first, &second, Vec2{it->tangent.y, -it->tangent.x})
+      kn = joint ? default_joint_stiffness(young_, first, &second,
+                                           Vec2{it->tangent.y, -it->tangent.x})
                  : kRigidJointFactor * young_ / length;
     } else if (!(kn > 0.0)) {
       kn = penalty_ * (3.0 / min_height_[std::size_t(a)] + 3.0 / min_height_[std::size_t(b)]);
@@ -558,32 +562,32 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
   double mb = 0.0, ma = 0.0;
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
-      const Index i = live_i_[live], j = live_j_[live];
-      if (box_lo_x_[i] > box_hi_x_[j] || box_lo_x_[j] > box_hi_x_[i] ||
-          box_lo_y_[i] > box_hi_y_[j] || box_lo_y_[j] > box_hi_y_[i])
-        continue;
-      const Vec2* pv = &world_[piece_first_[i]];
-      const Vec2* qv = &world_[piece_first_[j]];
-      const int np = piece_first_[i + 1] - piece_first_[i];
-      const int nq = piece_first_[j + 1] - piece_first_[j];
-      std::int16_t& apart = apart_line_[live];
-      if (apart >= 0 && separated_by(pv, np, qv, nq, apart)) continue;
-      ConvexOverlap o;
-      if (!convex_overlap(&ref_[piece_first_[i]], &disp_[piece_first_[i]], np,
-                          &ref_[piece_first_[j]], &disp_[piece_first_[j]], nq, o, energy)) {
-        apart = std::int16_t(separating_line(pv, np, qv, nq));
-        continue;
-      }
-      const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b
-      force = force + f;
-      mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
-      ma -= (o.centroid.x - ca_x) * f.y - (o.centroid.y - ca_y) * f.x;
-      area += o.area;
-      unit = o.normal;
-      ++regions;
-      gx += o.area * o.centroid.x, gy += o.area * o.centroid.y;
-      energy2 += o.depth_sq;
+    const Index i = live_i_[live], j = live_j_[live];
+    if (box_lo_x_[i] > box_hi_x_[j] || box_lo_x_[j] > box_hi_x_[i] || box_lo_y_[i] > box_hi_y_[j] ||
+        box_lo_y_[j] > box_hi_y_[i])
+      continue;
+    const Vec2* pv = &world_[piece_first_[i]];
+    const Vec2* qv = &world_[piece_first_[j]];
+    const int np = piece_first_[i + 1] - piece_first_[i];
+    const int nq = piece_first_[j + 1] - piece_first_[j];
+    std::int16_t& apart = apart_line_[live];
+    if (apart >= 0 && separated_by(pv, np, qv, nq, apart)) continue;
+    ConvexOverlap o;
+    if (!convex_overlap(&ref_[piece_first_[i]], &disp_[piece_first_[i]], np, &ref_[piece_first_[j]],
+                        &disp_[piece_first_[j]], nq, o, energy)) {
+      apart = std::int16_t(separating_line(pv, np, qv, nq));
+      continue;
     }
+    const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b
+    force = force + f;
+    mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
+    ma -= (o.centroid.x - ca_x) * f.y - (o.centroid.y - ca_y) * f.x;
+    area += o.area;
+    unit = o.normal;
+    ++regions;
+    gx += o.area * o.centroid.x, gy += o.area * o.centroid.y;
+    energy2 += o.depth_sq;
+  }
   double* w = &last_w_[4 * p];
   if (!(area > 0.0)) {
     slip_x_[p] = slip_y_[p] = 0.0;
@@ -600,8 +604,10 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
   out.fric_mb = out.fric_ma = 0.0;
   if (mu_ > 0.0) {
     // Relative displacement of b's material point at g with respect to a's over the last step.
-    const double ub_x = r.vx[b] - r.omega[b] * (g.y - cb_y), ub_y = r.vy[b] + r.omega[b] * (g.x - cb_x);
-    const double ua_x = r.vx[a] - r.omega[a] * (g.y - ca_y), ua_y = r.vy[a] + r.omega[a] * (g.x - ca_x);
+    const double ub_x = r.vx[b] - r.omega[b] * (g.y - cb_y),
+                 ub_y = r.vy[b] + r.omega[b] * (g.x - cb_x);
+    const double ua_x = r.vx[a] - r.omega[a] * (g.y - ca_y),
+                 ua_y = r.vy[a] + r.omega[a] * (g.x - ca_x);
     const Vec2 du{dt * (ub_x - ua_x), dt * (ub_y - ua_y)};
     // One overlap (a joint): its force kn |O| along its normal, no square root to take again.
     const FrictionResult fr =
@@ -753,7 +759,8 @@ void RigidContact::restore_state(const Model& model, const std::vector<char>& by
   std::size_t at = 0;
   const auto head = take<std::int64_t>(bytes, at);
   if (head.size() != 3) throw std::runtime_error("rigid contact state: bad header");
-  const auto cx = take<double>(bytes, at), cy = take<double>(bytes, at), th = take<double>(bytes, at);
+  const auto cx = take<double>(bytes, at), cy = take<double>(bytes, at),
+             th = take<double>(bytes, at);
   auto pa = take<Index>(bytes, at), pb = take<Index>(bytes, at);
   auto sx = take<double>(bytes, at), sy = take<double>(bytes, at), w = take<double>(bytes, at);
   auto dp = take<double>(bytes, at), fp = take<double>(bytes, at);

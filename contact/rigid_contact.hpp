@@ -71,8 +71,9 @@
 // positions taken from the bodies at detection only, candidate triangle pairs folded into
 // candidate block pairs, and of those the pairs whose outlines are within the buffer of each
 // other kept (the boxes of thin slanted blocks overlap their neighbours' neighbours: on the
-// church, 766 block pairs by boxes, 240 of them touching). A new detection is due when some body has moved a point of its
-// outline by more than buffer / 2 (bounded by |dc| + R |dtheta|, R the farthest outline point).
+// church, 766 block pairs by boxes, 240 of them touching). A new detection is due when some body
+// has moved a point of its outline by more than buffer / 2 (bounded by |dc| + R |dtheta|, R the
+// farthest outline point).
 
 #include <array>
 #include <cstdint>
@@ -117,9 +118,9 @@ int separating_line(const Vec2* p, int np, const Vec2* q, int nq);
 // force, friction and dashpot on b, and the moment of all of them about `origin` [N, N m].
 struct BlockPairForce {
   Index block_a = 0, block_b = 0;
-  Vec2 force;          // on b (minus this on a) [N]
-  Vec2 origin;         // point the moment is taken about [m]
-  double moment = 0.0; // of the forces on b about origin [N m]
+  Vec2 force;           // on b (minus this on a) [N]
+  Vec2 origin;          // point the moment is taken about [m]
+  double moment = 0.0;  // of the forces on b about origin [N m]
 };
 
 class RigidContact {
@@ -148,14 +149,14 @@ class RigidContact {
 
  private:
   struct PairOut {
-    Vec2 fb;                 // all forces on b [N]
+    Vec2 fb;                    // all forces on b [N]
     double mb = 0.0, ma = 0.0;  // moments on b about c_b, on a about c_a [N m]
-    Vec2 damp_b;             // dashpot part of fb
+    Vec2 damp_b;                // dashpot part of fb
     double damp_mb = 0.0, damp_ma = 0.0;
-    Vec2 fric_b;             // friction part of fb
+    Vec2 fric_b;  // friction part of fb
     double fric_mb = 0.0, fric_ma = 0.0;
     double energy = 0.0, stored = 0.0;
-    Vec2 point;              // G
+    Vec2 point;  // G
   };
   void world_pieces(const Model& model);
   double piece_gap(Index i, Index j) const;
@@ -197,9 +198,9 @@ class RigidContact {
 
   // Candidate block pairs (a < b), sorted, with their constants and state.
   std::vector<Index> pair_a_, pair_b_;
-  std::vector<double> kn_t_, kt_, beta_;       // [N/m2], [N/m], [s]
-  std::vector<double> slip_x_, slip_y_;        // friction state [m]
-  std::vector<double> last_w_;                 // 4 per pair: F_x, F_y, M_b, M_a of the last step
+  std::vector<double> kn_t_, kt_, beta_;  // [N/m2], [N/m], [s]
+  std::vector<double> slip_x_, slip_y_;   // friction state [m]
+  std::vector<double> last_w_;            // 4 per pair: F_x, F_y, M_b, M_a of the last step
   // The pairs of convex pieces of each candidate pair that were within the buffer at the
   // detection (pair p's: [live_first_[p], live_first_[p + 1]) of live_i_, live_j_), and for
   // each a side line that separated them at the last evaluation, or -1 (separated_by's

@@ -25,8 +25,8 @@ void make_blocks_rigid(Model& model) {
   const Triangles& t = model.tris;
   RigidBodies& r = model.rigid;
   const std::size_t nb = model.blocks.size();
-  for (auto* v : {&r.cx, &r.cy, &r.ux, &r.uy, &r.theta, &r.vx, &r.vy, &r.omega, &r.fx, &r.fy, &r.torque, &r.cx0,
-                  &r.cy0, &r.mass, &r.inertia, &r.load_mass})
+  for (auto* v : {&r.cx, &r.cy, &r.ux, &r.uy, &r.theta, &r.vx, &r.vy, &r.omega, &r.fx, &r.fy,
+                  &r.torque, &r.cx0, &r.cy0, &r.mass, &r.inertia, &r.load_mass})
     v->assign(nb, 0.0);
   r.rx.assign(n.x.size(), 0.0);
   r.ry.assign(n.x.size(), 0.0);
@@ -82,8 +82,8 @@ namespace {
 
 // The body update of integrate_rigid_bodies; `damping` (3 per body: x, y, rotation) when the
 // local damping is on (core/integrate.hpp LocalDamping), books its work into `dissipated`.
-double update_rigid_bodies(Model& model, double dt, double alpha, bool outgoing,
-                           double* previous, double& dissipated) {
+double update_rigid_bodies(Model& model, double dt, double alpha, bool outgoing, double* previous,
+                           double& dissipated) {
   RigidBodies& r = model.rigid;
   double twice_kinetic = 0.0;
   const Index nb = static_cast<Index>(model.blocks.size());

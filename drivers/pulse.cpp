@@ -2,10 +2,6 @@
 
 #include "drivers/pulse.hpp"
 
-#include "core/rigid.hpp"
-
-#include "core/fnv.hpp"
-
 #include <omp.h>
 
 #include <algorithm>
@@ -14,6 +10,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/fnv.hpp"
+#include "core/rigid.hpp"
 #include "drivers/bracket.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"

@@ -1,13 +1,12 @@
 #include "drivers/run.hpp"
 
-#include "core/rigid.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
+#include "core/rigid.hpp"
 #include "drivers/setup.hpp"
 
 namespace voussoir {

@@ -78,7 +78,8 @@ std::vector<JointResultant> resultants_of(const Model& model,
   // A rigid block pair: its force on the summed block and the moment about O; several joints
   // between the same two blocks take it at the first.
   for (const BlockPairForce& f : block_forces) {
-    const auto it = by_blocks.find({std::min(f.block_a, f.block_b), std::max(f.block_a, f.block_b)});
+    const auto it =
+        by_blocks.find({std::min(f.block_a, f.block_b), std::max(f.block_a, f.block_b)});
     if (it == by_blocks.end()) continue;
     const int j = it->second.front();
     const double sign = f.block_b == side[j] ? 1.0 : -1.0;  // forces on a are minus those on b
@@ -130,7 +131,8 @@ std::vector<JointResultant> joint_resultants(const Model& model,
 
 std::vector<JointResultant> joint_resultants(const Model& model, const ContactSystem& contact,
                                              double dt) {
-  if (contact.rigid_outlines()) return resultants_of(model, {}, contact.block_pair_forces(model, dt));
+  if (contact.rigid_outlines())
+    return resultants_of(model, {}, contact.block_pair_forces(model, dt));
   return joint_resultants(model, contact.pair_forces(model, dt));
 }
 

@@ -161,7 +161,8 @@ std::optional<Verdict> RestRule::check(const Probe& p) {
   // Kinetic energy below a millionth of the free mass's at the rest speed counts as none: at
   // rest a structure's kinetic energy is round-off of its contact forces, 0 after a kinetic-
   // damping reset and 1e-22 J the next step, which would read as growing.
-  if (kinetic_floor_ < 0.0) kinetic_floor_ = 0.5 * free_mass(p.sim.model) * 1e-6 * v_rest_ * v_rest_;
+  if (kinetic_floor_ < 0.0)
+    kinetic_floor_ = 0.5 * free_mass(p.sim.model) * 1e-6 * v_rest_ * v_rest_;
   const double kinetic = p.sim.ledger.kinetic > kinetic_floor_ ? p.sim.ledger.kinetic : 0.0;
   const bool still = detector_.update(p.time, p.speed, kinetic);
   // A refused rest is retried at the next sample: the speed window stays open.

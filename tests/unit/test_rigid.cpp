@@ -376,8 +376,7 @@ TEST(Rigid, StableStepIsSetByTheJointsNotTheElements) {
   // kn sets it: a 100 x stiffer joint, a 10 x shorter step.
   deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e12", "contact.restitution=1"},
            &stiff);
-  deck_sim(arch,
-           {"material.model=rigid", "contact.normal_stiffness=1e14", "contact.restitution=1"},
+  deck_sim(arch, {"material.model=rigid", "contact.normal_stiffness=1e14", "contact.restitution=1"},
            &stiffer);
   EXPECT_NEAR(stiff.dt / stiffer.dt, 10.0, 0.01);
   EXPECT_NE(soft.dt_set_by.find("rigid"), std::string::npos);

@@ -208,7 +208,8 @@ TEST(RigidContact, ShippedArchRunEndsInStaticEquilibrium) {
   const Config config = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml",
                                   {"solver.end_time=0.3"});
   Simulation sim = make_simulation(config);
-  run_loop(sim, 0.3, 1e-3, [](const Simulation&) { return true; }, true, "arch");
+  run_loop(
+      sim, 0.3, 1e-3, [](const Simulation&) { return true; }, true, "arch");
   const std::vector<JointResultant> joints = joint_resultants(sim.model, sim.contact, sim.ctx.dt);
   const std::size_t nj = joints.size();
   ASSERT_EQ(nj, 12u);
@@ -221,7 +222,8 @@ TEST(RigidContact, ShippedArchRunEndsInStaticEquilibrium) {
   for (std::size_t j = 0; j < nj / 2; ++j) {
     const JointResultant &left = joints[j], &right = joints[nj - 1 - j];
     ASSERT_TRUE(left.closed && right.closed) << "joint " << j;
-    EXPECT_NEAR(left.eccentricity, right.eccentricity, 0.01) << "joints " << j << ", " << nj - 1 - j;
+    EXPECT_NEAR(left.eccentricity, right.eccentricity, 0.01)
+        << "joints " << j << ", " << nj - 1 - j;
     EXPECT_NEAR(left.normal_force, right.normal_force, 1e-3 * weight) << "joint " << j;
   }
 }
