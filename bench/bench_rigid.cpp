@@ -12,6 +12,7 @@
 
 #include <string>
 
+#include "bench/timed_steps.hpp"
 #include "core/step.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
@@ -32,13 +33,7 @@ Simulation settled_church(const std::string& name) {
 void step_church(benchmark::State& state, const std::string& name) {
   Simulation sim = settled_church(name);
   sim.ctx.contact_energy = state.range(0) != 0;
-  sim.timers = StageTimers{};
-  sim.timers.enabled = true;
-  long long steps = 0;
-  for (auto _ : state) {
-    advance(sim);
-    ++steps;
-  }
+  const long long steps = timed_steps(state, sim);
   const double per = 1e6 / static_cast<double>(steps);
   const StageTimers& t = sim.timers;
   state.counters["us_broad"] = t.broad * per;

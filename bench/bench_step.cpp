@@ -12,6 +12,7 @@
 
 #include <string>
 
+#include "bench/timed_steps.hpp"
 #include "core/step.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
@@ -45,13 +46,7 @@ BENCHMARK(BM_StepCircularArch)->Arg(1)->Arg(2)->Arg(5)->Unit(benchmark::kMicrose
 // Where the time goes (stage timers of advance(), wall clock), for the 936-triangle arch.
 void BM_StepStages(benchmark::State& state) {
   Simulation sim = arch(static_cast<int>(state.range(0)));
-  sim.timers = StageTimers{};
-  sim.timers.enabled = true;
-  long long steps = 0;
-  for (auto _ : state) {
-    advance(sim);
-    ++steps;
-  }
+  const long long steps = timed_steps(state, sim);
   const StageTimers& t = sim.timers;
   const double per = 1e9 / static_cast<double>(steps);
   state.counters["broad_ns"] = t.broad * per;
