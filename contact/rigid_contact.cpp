@@ -330,23 +330,8 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
       radius_[b] = std::max(radius_[b],
                             std::hypot(model.nodes.x0[i] - origin.x, model.nodes.y0[i] - origin.y));
   }
-  const std::size_t pieces = piece_first_.size() - 1;
   world_ = ref_;
   disp_.assign(ref_.size(), Vec2{});
-  box_lo_x_.assign(pieces, 0.0), box_lo_y_.assign(pieces, 0.0);
-  box_hi_x_.assign(pieces, 0.0), box_hi_y_.assign(pieces, 0.0);
-  // Fixed blocks' pieces stay where they are.
-  for (std::size_t b = 0; b < nb; ++b) {
-    for (Index k = block_piece_[b]; k < block_piece_[b + 1]; ++k) {
-      double lx = std::numeric_limits<double>::infinity(), ly = lx, hx = -lx, hy = -lx;
-      for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v) {
-        lx = std::min(lx, ref_[v].x), hx = std::max(hx, ref_[v].x);
-        ly = std::min(ly, ref_[v].y), hy = std::max(hy, ref_[v].y);
-      }
-      box_lo_x_[k] = lx, box_lo_y_[k] = ly, box_hi_x_[k] = hx, box_hi_y_[k] = hy;
-    }
-  }
-
   // Joints per block pair: summed length, the direction of the longest.
   joints_.clear();
   for (const Joint& j : model.joints) {
@@ -535,17 +520,10 @@ void RigidContact::world_pieces(const Model& model) {
     half_angle(r.theta[b], sh, ch);
     const double cm1 = -2.0 * sh * sh, s = 2.0 * sh * ch;
     const double ux = r.ux[b], uy = r.uy[b];
-    for (Index k = block_piece_[b]; k < block_piece_[b + 1]; ++k) {
-      double lx = std::numeric_limits<double>::infinity(), ly = lx, hx = -lx, hy = -lx;
-      for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v) {
-        const Vec2 u{ux + cm1 * ref_x_[v] - s * ref_y_[v], uy + s * ref_x_[v] + cm1 * ref_y_[v]};
-        disp_[v] = u;
-        const double x = ref_[v].x + u.x, y = ref_[v].y + u.y;
-        world_[v] = {x, y};
-        lx = std::min(lx, x), hx = std::max(hx, x);
-        ly = std::min(ly, y), hy = std::max(hy, y);
-      }
-      box_lo_x_[k] = lx, box_lo_y_[k] = ly, box_hi_x_[k] = hx, box_hi_y_[k] = hy;
+    for (Index v = piece_first_[block_piece_[b]]; v < piece_first_[block_piece_[b + 1]]; ++v) {
+      const Vec2 u{ux + cm1 * ref_x_[v] - s * ref_y_[v], uy + s * ref_x_[v] + cm1 * ref_y_[v]};
+      disp_[v] = u;
+      world_[v] = {ref_[v].x + u.x, ref_[v].y + u.y};
     }
   }
 }
@@ -563,9 +541,6 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
     const Index i = live_i_[live], j = live_j_[live];
-    if (box_lo_x_[i] > box_hi_x_[j] || box_lo_x_[j] > box_hi_x_[i] || box_lo_y_[i] > box_hi_y_[j] ||
-        box_lo_y_[j] > box_hi_y_[i])
-      continue;
     const Vec2* pv = &world_[piece_first_[i]];
     const Vec2* qv = &world_[piece_first_[j]];
     const int np = piece_first_[i + 1] - piece_first_[i];

@@ -176,9 +176,8 @@ class RigidContact {
   std::vector<double> ref_x_, ref_y_;
   std::vector<Vec2> ref_;  // the same vertices' reference positions, as the model gives them
   // Current configuration (free blocks rewritten each step): each vertex's displacement from
-  // its reference position, the sum, and the piece boxes.
+  // its reference position, and the sum.
   std::vector<Vec2> disp_, world_;
-  std::vector<double> box_lo_x_, box_lo_y_, box_hi_x_, box_hi_y_;  // per piece
   // Per block: farthest outline point from the reference centroid [m], longest side [m].
   std::vector<double> radius_, longest_side_;
   // Joints between block pairs (model.joints), for the pair constants.
