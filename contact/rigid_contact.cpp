@@ -245,6 +245,13 @@ bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const 
   out.centroid = {ox + vx0 + mx * third, oy + vy0 + my * third};
   out.normal = {nx * inv_chord, ny * inv_chord};
   out.chord = chord;
+  // The points where the outlines cross: where a vertex's edges change from one outline to the
+  // other.
+  int crossings = 0;
+  double mx0 = 0.0, my0 = 0.0;
+  for (int k = 0; k < n; ++k)
+    if (lab[k] != lab[k > 0 ? k - 1 : n - 1]) mx0 += v[k].x, my0 += v[k].y, ++crossings;
+  out.chord_mid = crossings == 2 ? Vec2{ox + 0.5 * mx0, oy + 0.5 * my0} : out.centroid;
   out.depth_sq = 0.0;
   if (!with_energy) return true;
   // integral d^2 ds in the frame s along (n_y, -n_x), h along n (right-handed).
@@ -360,7 +367,7 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
   broad_.setup(model, buffer);
   detected_ = false;
   pair_a_.clear(), pair_b_.clear(), kn_t_.clear(), kt_.clear(), beta_.clear();
-  slip_x_.clear(), slip_y_.clear(), last_w_.clear();
+  slip_x_.clear(), slip_y_.clear(), touched_.clear();
   damp_now_.assign(3 * nb, 0.0), damp_prev_ = damp_now_;
   fric_now_ = damp_now_, fric_prev_ = damp_now_;
   stored_prev_ = 0.0;
@@ -425,7 +432,8 @@ void RigidContact::detect(const Model& model) {
   // Carry the friction slip and the dashpot's last wrench by the block pair.
   const std::size_t np = next.size();
   std::vector<Index> na(np), nbk(np);
-  std::vector<double> sx(np, 0.0), sy(np, 0.0), w(4 * np, 0.0);
+  std::vector<double> sx(np, 0.0), sy(np, 0.0);
+  std::vector<std::uint8_t> touched(np, 0);
   std::size_t o = 0;
   for (std::size_t p = 0; p < np; ++p) {
     na[p] = next[p].first, nbk[p] = next[p].second;
@@ -434,12 +442,12 @@ void RigidContact::detect(const Model& model) {
       ++o;
     if (o < pair_a_.size() && pair_a_[o] == na[p] && pair_b_[o] == nbk[p]) {
       sx[p] = slip_x_[o], sy[p] = slip_y_[o];
-      for (int k = 0; k < 4; ++k) w[4 * p + k] = last_w_[4 * o + k];
+      touched[p] = touched_[o];
     }
   }
   pair_a_.swap(na), pair_b_.swap(nbk);
   apart_line_.assign(live_i_.size(), -1);
-  slip_x_.swap(sx), slip_y_.swap(sy), last_w_.swap(w);
+  slip_x_.swap(sx), slip_y_.swap(sy), touched_.swap(touched);
   pair_constants(model);
   ref_ux_ = r.ux, ref_uy_ = r.uy, ref_theta_ = r.theta;
   detected_ = true;
@@ -539,6 +547,9 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
   int regions = 0;
   double mb = 0.0, ma = 0.0;
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
+  Vec2 damp;                                  // the dashpots' force on b
+  double damp_mb = 0.0, damp_ma = 0.0;        // and their moments on b and on a
+  const double c_damp = beta_[p] * kn_t_[p];  // beta kn t_z [N s/m2]
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
     const Index i = live_i_[live], j = live_j_[live];
     const Vec2* pv = &world_[piece_first_[i]];
@@ -562,11 +573,30 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
     ++regions;
     gx += o.area * o.centroid.x, gy += o.area * o.centroid.y;
     energy2 += o.depth_sq;
+    if (damping_) {
+      // The viscous Winkler joint along this overlap's chord (rigid_contact.hpp).
+      const Vec2 xm = o.chord_mid, n = o.normal;
+      const double vb_x = r.vx[b] - r.omega[b] * (xm.y - cb_y);
+      const double vb_y = r.vy[b] + r.omega[b] * (xm.x - cb_x);
+      const double va_x = r.vx[a] - r.omega[a] * (xm.y - ca_y);
+      const double va_y = r.vy[a] + r.omega[a] * (xm.x - ca_x);
+      const double rate_m = -(n.x * (vb_x - va_x) + n.y * (vb_y - va_y));
+      const double rate_s = -(r.omega[b] - r.omega[a]);
+      const double len = o.chord;
+      // The step a pair first touches, it has touched for the part of the step its mean depth
+      // |O| / L took to reach at the approach rate: the dashpot acts for that part only.
+      double part = 1.0;
+      if (!touched_[p] && rate_m * dt * len > o.area) part = o.area / (rate_m * dt * len);
+      const Vec2 fd = (part * c_damp * len * rate_m) * n;
+      const double twist = part * c_damp * len * len * len / 12.0 * rate_s;
+      damp = damp + fd;
+      damp_mb += (xm.x - cb_x) * fd.y - (xm.y - cb_y) * fd.x + twist;
+      damp_ma -= (xm.x - ca_x) * fd.y - (xm.y - ca_y) * fd.x + twist;
+    }
   }
-  double* w = &last_w_[4 * p];
+  touched_[p] = area > 0.0;
   if (!(area > 0.0)) {
     slip_x_[p] = slip_y_[p] = 0.0;
-    w[0] = w[1] = w[2] = w[3] = 0.0;
     return false;
   }
   const Vec2 g{gx / area, gy / area};
@@ -597,17 +627,12 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
     out.fb = out.fb + fr.force;
     out.mb += out.fric_mb, out.ma += out.fric_ma;
   }
-  out.damp_b = {};
-  out.damp_mb = out.damp_ma = 0.0;
+  out.damp_b = damp;
+  out.damp_mb = damp_mb, out.damp_ma = damp_ma;
   if (damping_) {
-    const double k = beta_[p] / dt;
-    out.damp_b = {k * (force.x - w[0]), k * (force.y - w[1])};
-    out.damp_mb = k * (mb - w[2]);
-    out.damp_ma = k * (ma - w[3]);
-    out.fb = out.fb + out.damp_b;
-    out.mb += out.damp_mb, out.ma += out.damp_ma;
+    out.fb = out.fb + damp;
+    out.mb += damp_mb, out.ma += damp_ma;
   }
-  w[0] = force.x, w[1] = force.y, w[2] = mb, w[3] = ma;
   return true;
 }
 
@@ -724,7 +749,7 @@ std::vector<char> RigidContact::save_state() const {
   put(out, std::vector<std::int64_t>{detected_ ? 1 : 0, detections_, active_});
   put(out, ref_ux_), put(out, ref_uy_), put(out, ref_theta_);
   put(out, pair_a_), put(out, pair_b_);
-  put(out, slip_x_), put(out, slip_y_), put(out, last_w_);
+  put(out, slip_x_), put(out, slip_y_), put(out, touched_);
   put(out, damp_prev_), put(out, fric_prev_);
   put(out, std::vector<double>{stored_prev_});
   return out;
@@ -737,11 +762,12 @@ void RigidContact::restore_state(const Model& model, const std::vector<char>& by
   const auto cx = take<double>(bytes, at), cy = take<double>(bytes, at),
              th = take<double>(bytes, at);
   auto pa = take<Index>(bytes, at), pb = take<Index>(bytes, at);
-  auto sx = take<double>(bytes, at), sy = take<double>(bytes, at), w = take<double>(bytes, at);
+  auto sx = take<double>(bytes, at), sy = take<double>(bytes, at);
+  auto touched = take<std::uint8_t>(bytes, at);
   auto dp = take<double>(bytes, at), fp = take<double>(bytes, at);
   const auto sp = take<double>(bytes, at);
   const std::size_t nb = model.blocks.size();
-  if (sx.size() != pa.size() || sy.size() != pa.size() || w.size() != 4 * pa.size() ||
+  if (sx.size() != pa.size() || sy.size() != pa.size() || touched.size() != pa.size() ||
       pb.size() != pa.size() || dp.size() != 3 * nb || fp.size() != 3 * nb || sp.size() != 1)
     throw std::runtime_error("rigid contact state does not fit this model");
   if (head[0]) {
@@ -752,12 +778,12 @@ void RigidContact::restore_state(const Model& model, const std::vector<char>& by
     RigidBodies& r = at_detection.rigid;
     r.ux = cx, r.uy = cy, r.theta = th;
     for (std::size_t b = 0; b < nb; ++b) r.cx[b] = r.cx0[b] + r.ux[b], r.cy[b] = r.cy0[b] + r.uy[b];
-    pair_a_.clear(), pair_b_.clear(), slip_x_.clear(), slip_y_.clear(), last_w_.clear();
+    pair_a_.clear(), pair_b_.clear(), slip_x_.clear(), slip_y_.clear(), touched_.clear();
     detect(at_detection);
     if (pair_a_ != pa || pair_b_ != pb)
       throw std::runtime_error("rigid contact state: the candidate pairs differ from the model's");
   }
-  slip_x_ = sx, slip_y_ = sy, last_w_ = w;
+  slip_x_ = sx, slip_y_ = sy, touched_ = touched;
   damp_prev_ = dp, fric_prev_ = fp;
   stored_prev_ = sp[0];
   detections_ = head[1];

@@ -56,12 +56,20 @@
 // increment is the relative displacement of B's and A's material points at G over the last
 // step, dt times the rigid velocity field of the half step.
 //
-// Impact damping (contact.restitution < 1): the dashpot beta dW/dt on the rate of the pair's
-// normal-force wrench W = (F_n, its moment about each block's centroid), beta = 2 zeta /
-// omega as in joint_stiffness.hpp (omega the joint's frequency with the blocks' masses), by
-// the backward difference; this is beta K qdot, the stiffness-proportional dashpot of the
-// joint, and it damps a block rocking on its joint (the moment changes) as well as a bounce.
-// A pair that stops touching drops its history and gets no dashpot force (no tension).
+// Impact damping (contact.restitution < 1): the joint's pressure is kn (d + beta d'), d' the
+// rate of penetration, beta = 2 zeta / omega as in joint_stiffness.hpp (omega the joint's
+// frequency with the blocks' masses): a Winkler joint with a dashpot beta kn per unit area,
+// stiffness-proportional, the linear spring-dashpot of a flat drop (restitution e). Along the
+// chord (length L, middle x_m, s from -L/2 to L/2) the rigid bodies give a linear rate
+//     d'(s) = d'_m + d'_s s,   d'_m = -n . (v_b(x_m) - v_a(x_m)),   d'_s = -(w_b - w_a),
+// v_X(x) = v_X + w_X x (x - c_X) the half-step velocity field, so the dashpot's force on b is
+//     F_d = beta kn t_z L d'_m n,   moment about c_b: (x_m - c_b) x F_d + beta kn t_z L^3/12 d'_s,
+// minus these on a, and it dissipates beta kn t_z (L d'_m^2 + L^3/12 d'_s^2) >= 0: a rigid
+// motion of the pair (d' = 0) costs nothing, a bounce and the rocking of a block on its joint
+// (the pressure's rate changing along the joint) are damped. (Rejected: beta times the rate of
+// the pair's force and moments, a backward difference in the fixed frame. A pair turning with
+// the structure turns its force, and that dashpot then pushed along the turn: on the
+// shaking-table arch it fed a slow sway that never came to rest.)
 //
 // Ledger: the dashpots' and friction's generalized forces on each body are booked by the
 // trapezoid over the body's position increment (dt v^(n-1/2), dt omega^(n-1/2)), as the
@@ -92,7 +100,8 @@ struct ConvexOverlap {
   double area = 0.0;      // |O| [m2]
   Vec2 centroid;          // G [m]
   Vec2 normal;            // n, unit, out of P into Q
-  double chord = 0.0;     // |N_P| [m]
+  double chord = 0.0;     // |N_P| [m]: the distance between the points where the outlines cross
+  Vec2 chord_mid;         // the middle of those two points [m] (the centroid when not found)
   double depth_sq = 0.0;  // integral of d(s)^2 ds along the chord [m3]
 };
 
@@ -199,6 +208,7 @@ class RigidContact {
   std::vector<Index> pair_a_, pair_b_;
   std::vector<double> kn_t_, kt_, beta_;  // [N/m2], [N/m], [s]
   std::vector<double> slip_x_, slip_y_;   // friction state [m]
+  std::vector<std::uint8_t> touched_;     // 1 when the pair touched at the last step
   std::vector<double> last_w_;            // 4 per pair: F_x, F_y, M_b, M_a of the last step
   // The pairs of convex pieces of each candidate pair that were within the buffer at the
   // detection (pair p's: [live_first_[p], live_first_[p + 1]) of live_i_, live_j_), and for
