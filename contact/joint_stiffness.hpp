@@ -89,10 +89,10 @@ inline constexpr double kRigidJointFactor = 100.0;
 
 // Restitution of rigid blocks' joints when the deck gives none, in the physical runs (run,
 // pulse, stability, capacity --dynamic). Undamped joints never come to rest: a rigid arch
-// rings on them for good (kinetic energy 1e-6 J, but joint forces off by 1e3 N and a lopsided
-// line of thrust on a symmetric arch after 0.3 s), whereas at 0.5 its springings carry its
-// weight to 1e-5 and mirror joints agree to 1e-4 by then (docs/rigid.md, "Joint damping by
-// default"); 0.8 still does, 0.95 does not. 0.5 is the middle of the restitution measured
+// rings on them for good (joint forces off by 1e2 to 1e3 N and a lopsided line of thrust on a
+// symmetric arch after 0.3 s), whereas at 0.5 its springings carry its weight to 1e-5 and
+// mirror joints agree to 1e-4 by then (docs/rigid.md, "Joint damping by default"); 0.8 still
+// does, 0.95 does not. 0.5 is the middle of the restitution measured
 // for stone blocks rocking and bouncing (0.3 to 0.7). Cost: the damped step is
 // kRigidDampedStepFraction (core/rigid.hpp), half the undamped one. The quasi-static phases
 // (capacity and sweep trials, their settle) damp every motion by their own technique and take
