@@ -429,7 +429,7 @@ void RigidContact::detect(const Model& model) {
   }
   next.swap(kept);
   live_first_.swap(live_first), live_i_.swap(live_i), live_j_.swap(live_j);
-  // Carry the friction slip and the dashpot's last wrench by the block pair.
+  // Carry the friction slip and whether the pair touched by the block pair.
   const std::size_t np = next.size();
   std::vector<Index> na(np), nbk(np);
   std::vector<double> sx(np, 0.0), sy(np, 0.0);
