@@ -266,22 +266,35 @@ bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const 
 }
 
 int separating_line(const Vec2* p, int np, const Vec2* q, int nq) {
-  for (int j = 0; j < nq + np; ++j) {
-    if (separated_by(p, np, q, nq, j)) return j;
-  }
+  return separating_line(p, nullptr, np, q, nullptr, nq);
+}
+
+int separating_line(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq) {
+  for (int j = 0; j < nq + np; ++j)
+    if (separated_by(p, pu, np, q, qu, nq, j)) return j;
   return -1;
 }
 
 bool separated_by(const Vec2* p, int np, const Vec2* q, int nq, int line) {
+  return separated_by(p, nullptr, np, q, nullptr, nq, line);
+}
+
+bool separated_by(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
+                  int line) {
   // Line `line` of Q (line < nq) with P's vertices, or of P (line - nq) with Q's.
-  const Vec2* owner = q;
-  const Vec2* other = p;
+  const Vec2 *owner = q, *owner_u = qu, *other = p, *other_u = pu;
   int no = nq, nt = np, j = line;
-  if (line >= nq) owner = p, other = q, no = np, nt = nq, j = line - nq;
-  const Vec2 a = owner[j], b = owner[j + 1 < no ? j + 1 : 0];
+  if (line >= nq) owner = p, owner_u = pu, other = q, other_u = qu, no = np, nt = nq, j = line - nq;
+  auto at = [](const Vec2* x, const Vec2* u, int k) {
+    return u ? Vec2{x[k].x + u[k].x, x[k].y + u[k].y} : x[k];
+  };
+  const int j1 = j + 1 < no ? j + 1 : 0;
+  const Vec2 a = at(owner, owner_u, j), b = at(owner, owner_u, j1);
   const double ex = b.x - a.x, ey = b.y - a.y;
-  for (int k = 0; k < nt; ++k)
-    if (ex * (other[k].y - a.y) - ey * (other[k].x - a.x) >= 0.0) return false;
+  for (int k = 0; k < nt; ++k) {
+    const Vec2 v = at(other, other_u, k);
+    if (ex * (v.y - a.y) - ey * (v.x - a.x) >= 0.0) return false;
+  }
   return true;
 }
 
@@ -337,7 +350,6 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
       radius_[b] = std::max(radius_[b],
                             std::hypot(model.nodes.x0[i] - origin.x, model.nodes.y0[i] - origin.y));
   }
-  world_ = ref_;
   disp_.assign(ref_.size(), Vec2{});
   // Joints per block pair: summed length, the direction of the longest.
   joints_.clear();
@@ -457,10 +469,17 @@ void RigidContact::detect(const Model& model) {
 // Smallest distance between convex pieces i and j at the current configuration (0 when they
 // overlap) [m].
 double RigidContact::piece_gap(Index i, Index j) const {
-  const Vec2* p = &world_[piece_first_[i]];
-  const Vec2* q = &world_[piece_first_[j]];
-  const int np = piece_first_[i + 1] - piece_first_[i];
-  const int nq = piece_first_[j + 1] - piece_first_[j];
+  auto current = [this](Index k) {
+    std::vector<Vec2> v;
+    for (Index a = piece_first_[k]; a < piece_first_[k + 1]; ++a)
+      v.push_back({ref_[a].x + disp_[a].x, ref_[a].y + disp_[a].y});
+    return v;
+  };
+  const std::vector<Vec2> pp = current(i), qq = current(j);
+  const Vec2* p = pp.data();
+  const Vec2* q = qq.data();
+  const int np = int(pp.size());
+  const int nq = int(qq.size());
   if (separating_line(p, np, q, nq) < 0) return 0.0;  // convex pieces not apart: overlap
   double gap = std::numeric_limits<double>::infinity();
   for (int k = 0; k < np; ++k)
@@ -531,7 +550,6 @@ void RigidContact::world_pieces(const Model& model) {
     for (Index v = piece_first_[block_piece_[b]]; v < piece_first_[block_piece_[b + 1]]; ++v) {
       const Vec2 u{ux + cm1 * ref_x_[v] - s * ref_y_[v], uy + s * ref_x_[v] + cm1 * ref_y_[v]};
       disp_[v] = u;
-      world_[v] = {ref_[v].x + u.x, ref_[v].y + u.y};
     }
   }
 }
@@ -552,16 +570,15 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
   const double c_damp = beta_[p] * kn_t_[p];  // beta kn t_z [N s/m2]
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
     const Index i = live_i_[live], j = live_j_[live];
-    const Vec2* pv = &world_[piece_first_[i]];
-    const Vec2* qv = &world_[piece_first_[j]];
+    const Vec2 *pv = &ref_[piece_first_[i]], *pu = &disp_[piece_first_[i]];
+    const Vec2 *qv = &ref_[piece_first_[j]], *qu = &disp_[piece_first_[j]];
     const int np = piece_first_[i + 1] - piece_first_[i];
     const int nq = piece_first_[j + 1] - piece_first_[j];
     std::int16_t& apart = apart_line_[live];
-    if (apart >= 0 && separated_by(pv, np, qv, nq, apart)) continue;
+    if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
     ConvexOverlap o;
-    if (!convex_overlap(&ref_[piece_first_[i]], &disp_[piece_first_[i]], np, &ref_[piece_first_[j]],
-                        &disp_[piece_first_[j]], nq, o, energy)) {
-      apart = std::int16_t(separating_line(pv, np, qv, nq));
+    if (!convex_overlap(pv, pu, np, qv, qu, nq, o, energy)) {
+      apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
       continue;
     }
     const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b

@@ -126,6 +126,10 @@ bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const 
 // wholly outside it: the two are apart. separating_line returns the first such line or -1.
 bool separated_by(const Vec2* p, int np, const Vec2* q, int nq, int line);
 int separating_line(const Vec2* p, int np, const Vec2* q, int nq);
+// The same with each vertex a reference position plus a displacement (pu, qu; null: none).
+bool separated_by(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
+                  int line);
+int separating_line(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq);
 
 // Force of a touching block pair (a, b) as the contact stage applies it: the sum of the normal
 // force, friction and dashpot on b, and the moment of all of them about `origin` [N, N m].
@@ -189,8 +193,8 @@ class RigidContact {
   std::vector<double> ref_x_, ref_y_;
   std::vector<Vec2> ref_;  // the same vertices' reference positions, as the model gives them
   // Current configuration (free blocks rewritten each step): each vertex's displacement from
-  // its reference position, and the sum.
-  std::vector<Vec2> disp_, world_;
+  // its reference position.
+  std::vector<Vec2> disp_;
   // Per block: farthest outline point from the reference centroid [m], longest side [m].
   std::vector<double> radius_, longest_side_;
   // Joints between block pairs (model.joints), for the pair constants.
