@@ -53,6 +53,7 @@
 #include "contact/joint_stiffness.hpp"
 #include "contact/narrow_phase.hpp"
 #include "contact/rigid_contact.hpp"
+#include "contact/state_bytes.hpp"
 #include "core/parallel.hpp"
 
 namespace voussoir {
@@ -273,7 +274,8 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
   s.stored_prev = 0.0;
   const Participants parts = select_participants(model);
   const double buffer = params.buffer > 0.0 ? params.buffer : default_buffer(model, parts);
-  s.broad.setup(model, buffer);
+  // Rigid blocks detect on their own broad phase (contact/rigid_contact.hpp).
+  if (!model.is_rigid()) s.broad.setup(model, buffer);
   const std::vector<Index>& free_nodes = s.broad.participants().free_nodes;
   s.free_block.resize(free_nodes.size());
   for (std::size_t k = 0; k < free_nodes.size(); ++k)
@@ -312,7 +314,7 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
     }
   }
   s.rigid_mode = model.is_rigid();
-  if (s.rigid_mode) s.rigid.setup(model, params, s.penalty, s.block_min_height);
+  if (s.rigid_mode) s.rigid.setup(model, params, s.penalty, buffer, s.block_min_height);
   s.ready = true;
 }
 
@@ -499,46 +501,6 @@ constexpr std::uint64_t kStateTag1 = 0x564f555353434f31ull;  // "VOUSSCO1": no d
 constexpr std::uint64_t kStateTag2 = 0x564f555353434f32ull;  // "VOUSSCO2": no friction arrays
 constexpr std::uint64_t kStateTag3 = 0x564f555353434f33ull;  // "VOUSSCO3": |f| dashpot state
 constexpr std::uint64_t kStateTag = 0x564f555353434f34ull;   // "VOUSSCO4"
-
-void put_bytes(std::vector<char>& out, const void* p, std::size_t n) {
-  const std::size_t at = out.size();
-  out.resize(at + n);
-  if (n > 0) std::memcpy(out.data() + at, p, n);
-}
-template <class T>
-void put(std::vector<char>& out, const T& v) {
-  put_bytes(out, &v, sizeof v);
-}
-template <class T>
-void put_array(std::vector<char>& out, const std::vector<T>& v) {
-  put<std::uint64_t>(out, v.size());
-  put_bytes(out, v.data(), v.size() * sizeof(T));
-}
-
-struct StateReader {
-  const std::vector<char>& in;
-  std::size_t pos = 0;
-  [[noreturn]] static void fail(const std::string& why) {
-    throw std::runtime_error("contact state: " + why);
-  }
-  template <class T>
-  T get() {
-    T v{};
-    if (sizeof v > in.size() - pos) fail("truncated");
-    std::memcpy(&v, in.data() + pos, sizeof v);
-    pos += sizeof v;
-    return v;
-  }
-  template <class T>
-  std::vector<T> get_array() {
-    const auto n = get<std::uint64_t>();
-    if (n > (in.size() - pos) / sizeof(T)) fail("truncated");
-    std::vector<T> v(n);
-    if (n > 0) std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
-    pos += n * sizeof(T);
-    return v;
-  }
-};
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include "contact/contact.hpp"
 #include "contact/friction.hpp"
 #include "contact/joint_stiffness.hpp"
+#include "contact/state_bytes.hpp"
 
 namespace voussoir {
 
@@ -299,7 +300,7 @@ bool separated_by(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Ve
 }
 
 void RigidContact::setup(const Model& model, const ContactParams& params, double penalty,
-                         const std::vector<double>& block_min_height) {
+                         double buffer, const std::vector<double>& block_min_height) {
   const RigidBodies& r = model.rigid;
   mu_ = params.friction;
   thickness_ = model.out_of_plane;
@@ -315,8 +316,6 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
   const std::size_t nb = model.blocks.size();
   piece_first_.assign(1, 0);
   block_piece_.assign(1, 0);
-  ref_x_.clear();
-  ref_y_.clear();
   ref_.clear();
   radius_.assign(nb, 0.0);
   longest_side_.assign(nb, 0.0);
@@ -338,12 +337,8 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
       }
     }
     for (const std::vector<Vec2>& piece : pieces) {
-      for (const Vec2& v : piece) {
-        ref_x_.push_back(v.x - origin.x);
-        ref_y_.push_back(v.y - origin.y);
-        ref_.push_back(v);
-      }
-      piece_first_.push_back(Index(ref_x_.size()));
+      ref_.insert(ref_.end(), piece.begin(), piece.end());
+      piece_first_.push_back(Index(ref_.size()));
     }
     block_piece_.push_back(Index(piece_first_.size() - 1));
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i)
@@ -374,8 +369,6 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
 
   // Broad phase on the outline triangles.
   scratch_ = model.nodes;
-  const Participants parts = select_participants(model);
-  const double buffer = params.buffer > 0.0 ? params.buffer : default_buffer(model, parts);
   broad_.setup(model, buffer);
   detected_ = false;
   pair_a_.clear(), pair_b_.clear(), kn_t_.clear(), kt_.clear(), beta_.clear();
@@ -402,16 +395,24 @@ bool RigidContact::needs_detection(const Model& model) const {
 }
 
 void RigidContact::detect(const Model& model) {
+  detect_at(model, model.rigid.ux, model.rigid.uy, model.rigid.theta);
+}
+
+// The detection with the bodies at the poses (ux, uy, theta): the model's own, or a
+// checkpoint's last detection's.
+void RigidContact::detect_at(const Model& model, const std::vector<double>& ux,
+                             const std::vector<double>& uy, const std::vector<double>& theta) {
   const RigidBodies& r = model.rigid;
   const std::size_t nb = model.blocks.size();
   // Node positions from the bodies (the outline triangles' corners).
   for (std::size_t b = 0; b < nb; ++b) {
     const Block& blk = model.blocks[b];
     if (blk.fixed || !(r.mass[b] > 0.0)) continue;
-    const double c = std::cos(r.theta[b]), s = std::sin(r.theta[b]);
+    const double c = std::cos(theta[b]), s = std::sin(theta[b]);
+    const double cx = r.cx0[b] + ux[b], cy = r.cy0[b] + uy[b];
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
-      scratch_.x[i] = r.cx[b] + c * r.rx[i] - s * r.ry[i];
-      scratch_.y[i] = r.cy[b] + s * r.rx[i] + c * r.ry[i];
+      scratch_.x[i] = cx + c * r.rx[i] - s * r.ry[i];
+      scratch_.y[i] = cy + s * r.rx[i] + c * r.ry[i];
     }
   }
   broad_.detect(scratch_, tri_pairs_);
@@ -427,7 +428,7 @@ void RigidContact::detect(const Model& model) {
   // Keep the pairs whose outlines are within the buffer of each other, and of each the pairs of
   // convex pieces that are: until the next detection every outline point moves by at most
   // buffer / 2, so the others stay apart.
-  world_pieces(model);
+  displace_pieces(model, ux, uy, theta);
   const double reach = broad_.buffer();
   std::vector<std::pair<Index, Index>> kept;
   std::vector<Index> live_first{0}, live_i, live_j;
@@ -461,7 +462,7 @@ void RigidContact::detect(const Model& model) {
   apart_line_.assign(live_i_.size(), -1);
   slip_x_.swap(sx), slip_y_.swap(sy), touched_.swap(touched);
   pair_constants(model);
-  ref_ux_ = r.ux, ref_uy_ = r.uy, ref_theta_ = r.theta;
+  ref_ux_ = ux, ref_uy_ = uy, ref_theta_ = theta;
   detected_ = true;
   ++detections_;
 }
@@ -536,7 +537,9 @@ void RigidContact::pair_constants(const Model& model) {
   }
 }
 
-void RigidContact::world_pieces(const Model& model) {
+void RigidContact::displace_pieces(const Model& model, const std::vector<double>& ux_of,
+                                   const std::vector<double>& uy_of,
+                                   const std::vector<double>& theta) {
   const RigidBodies& r = model.rigid;
   const std::size_t nb = model.blocks.size();
   for (std::size_t b = 0; b < nb; ++b) {
@@ -544,11 +547,13 @@ void RigidContact::world_pieces(const Model& model) {
     // Displacement of each vertex, u = (c - c0) + (R - I) r with cos - 1 = -2 sin^2(theta/2):
     // small numbers computed to their own round-off.
     double sh, ch;
-    half_angle(r.theta[b], sh, ch);
+    half_angle(theta[b], sh, ch);
     const double cm1 = -2.0 * sh * sh, s = 2.0 * sh * ch;
-    const double ux = r.ux[b], uy = r.uy[b];
+    const double ux = ux_of[b], uy = uy_of[b];
     for (Index v = piece_first_[block_piece_[b]]; v < piece_first_[block_piece_[b + 1]]; ++v) {
-      const Vec2 u{ux + cm1 * ref_x_[v] - s * ref_y_[v], uy + s * ref_x_[v] + cm1 * ref_y_[v]};
+      // r: the vertex's offset from the reference centroid
+      const double rx = ref_[v].x - r.cx0[b], ry = ref_[v].y - r.cy0[b];
+      const Vec2 u{ux + cm1 * rx - s * ry, uy + s * rx + cm1 * ry};
       disp_[v] = u;
     }
   }
@@ -617,7 +622,6 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
     return false;
   }
   const Vec2 g{gx / area, gy / area};
-  out.point = g;
   out.energy = 0.5 * kn_t_[p] * energy2;
   out.fb = force;
   out.mb = mb, out.ma = ma;
@@ -659,7 +663,7 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, boo
     ledger.contact = 0.0;
     return;
   }
-  world_pieces(model);
+  displace_pieces(model, r.ux, r.uy, r.theta);
   double energy = 0.0, stored = 0.0;
   std::int64_t active = 0;
   PairOut out;
@@ -714,8 +718,8 @@ std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double
   if (!detected_) return forces;
   RigidContact copy(*this);
   if (copy.needs_detection(model)) copy.detect(model);
-  copy.world_pieces(model);
   const RigidBodies& r = model.rigid;
+  copy.displace_pieces(model, r.ux, r.uy, r.theta);
   PairOut out;
   for (std::size_t p = 0; p < copy.pair_a_.size(); ++p) {
     if (!copy.evaluate(p, model, dt, true, out)) continue;
@@ -735,76 +739,48 @@ std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double
   return forces;
 }
 
-namespace {
-
-template <class T>
-void put(std::vector<char>& out, const std::vector<T>& v) {
-  const std::uint64_t n = v.size();
-  const char* p = reinterpret_cast<const char*>(&n);
-  out.insert(out.end(), p, p + sizeof n);
-  p = reinterpret_cast<const char*>(v.data());
-  out.insert(out.end(), p, p + n * sizeof(T));
-}
-
-template <class T>
-std::vector<T> take(const std::vector<char>& in, std::size_t& at) {
-  std::uint64_t n = 0;
-  if (at + sizeof n > in.size()) throw std::runtime_error("rigid contact state: truncated");
-  std::memcpy(&n, in.data() + at, sizeof n);
-  at += sizeof n;
-  if (n > (in.size() - at) / sizeof(T)) throw std::runtime_error("rigid contact state: truncated");
-  std::vector<T> v(n);
-  std::memcpy(v.data(), in.data() + at, n * sizeof(T));
-  at += n * sizeof(T);
-  return v;
-}
-
-}  // namespace
-
 std::vector<char> RigidContact::save_state() const {
   std::vector<char> out;
-  put(out, std::vector<std::int64_t>{detected_ ? 1 : 0, detections_, active_});
-  put(out, ref_ux_), put(out, ref_uy_), put(out, ref_theta_);
-  put(out, pair_a_), put(out, pair_b_);
-  put(out, slip_x_), put(out, slip_y_), put(out, touched_);
-  put(out, damp_prev_), put(out, fric_prev_);
-  put(out, std::vector<double>{stored_prev_});
+  put<std::uint8_t>(out, detected_ ? 1 : 0);
+  put<std::int64_t>(out, detections_);
+  put<std::int64_t>(out, active_);
+  put_array(out, ref_ux_), put_array(out, ref_uy_), put_array(out, ref_theta_);
+  put_array(out, pair_a_), put_array(out, pair_b_);
+  put_array(out, slip_x_), put_array(out, slip_y_), put_array(out, touched_);
+  put_array(out, damp_prev_), put_array(out, fric_prev_);
+  put<double>(out, stored_prev_);
   return out;
 }
 
 void RigidContact::restore_state(const Model& model, const std::vector<char>& bytes) {
-  std::size_t at = 0;
-  const auto head = take<std::int64_t>(bytes, at);
-  if (head.size() != 3) throw std::runtime_error("rigid contact state: bad header");
-  const auto cx = take<double>(bytes, at), cy = take<double>(bytes, at),
-             th = take<double>(bytes, at);
-  auto pa = take<Index>(bytes, at), pb = take<Index>(bytes, at);
-  auto sx = take<double>(bytes, at), sy = take<double>(bytes, at);
-  auto touched = take<std::uint8_t>(bytes, at);
-  auto dp = take<double>(bytes, at), fp = take<double>(bytes, at);
-  const auto sp = take<double>(bytes, at);
+  StateReader in{bytes};
+  const bool detected = in.get<std::uint8_t>() != 0;
+  const auto detections = in.get<std::int64_t>(), active = in.get<std::int64_t>();
+  const auto ux = in.get_array<double>(), uy = in.get_array<double>();
+  const auto th = in.get_array<double>();
+  auto pa = in.get_array<Index>(), pb = in.get_array<Index>();
+  auto sx = in.get_array<double>(), sy = in.get_array<double>();
+  auto touched = in.get_array<std::uint8_t>();
+  auto dp = in.get_array<double>(), fp = in.get_array<double>();
+  const double stored_prev = in.get<double>();
+  if (in.pos != bytes.size()) in.fail("unexpected data after the rigid contact state");
   const std::size_t nb = model.blocks.size();
   if (sx.size() != pa.size() || sy.size() != pa.size() || touched.size() != pa.size() ||
-      pb.size() != pa.size() || dp.size() != 3 * nb || fp.size() != 3 * nb || sp.size() != 1)
-    throw std::runtime_error("rigid contact state does not fit this model");
-  if (head[0]) {
-    if (cx.size() != nb || cy.size() != nb || th.size() != nb)
-      throw std::runtime_error("rigid contact state does not fit this model");
+      pb.size() != pa.size() || dp.size() != 3 * nb || fp.size() != 3 * nb)
+    in.fail("rigid contact state does not fit this model");
+  if (detected) {
+    if (ux.size() != nb || uy.size() != nb || th.size() != nb)
+      in.fail("rigid contact state does not fit this model");
     // The last detection again, from the bodies' poses then: the same candidates and reference.
-    Model at_detection = model;
-    RigidBodies& r = at_detection.rigid;
-    r.ux = cx, r.uy = cy, r.theta = th;
-    for (std::size_t b = 0; b < nb; ++b) r.cx[b] = r.cx0[b] + r.ux[b], r.cy[b] = r.cy0[b] + r.uy[b];
     pair_a_.clear(), pair_b_.clear(), slip_x_.clear(), slip_y_.clear(), touched_.clear();
-    detect(at_detection);
-    if (pair_a_ != pa || pair_b_ != pb)
-      throw std::runtime_error("rigid contact state: the candidate pairs differ from the model's");
+    detect_at(model, ux, uy, th);
+    if (pair_a_ != pa || pair_b_ != pb) in.fail("the candidate pairs differ from the model's");
   }
   slip_x_ = sx, slip_y_ = sy, touched_ = touched;
   damp_prev_ = dp, fric_prev_ = fp;
-  stored_prev_ = sp[0];
-  detections_ = head[1];
-  active_ = head[2];
+  stored_prev_ = stored_prev;
+  detections_ = detections;
+  active_ = active;
 }
 
 }  // namespace voussoir

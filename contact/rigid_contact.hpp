@@ -142,9 +142,10 @@ struct BlockPairForce {
 
 class RigidContact {
  public:
-  // Outlines, convex pieces, per-block constants, the broad phase. `penalty` [Pa] and
-  // `block_min_height` (per block [m]) serve the penalty mode (no joint stiffness given).
-  void setup(const Model& model, const ContactParams& params, double penalty,
+  // Outlines, convex pieces, per-block constants, the broad phase with its `buffer` [m].
+  // `penalty` [Pa] and `block_min_height` (per block [m]) serve the penalty mode (no joint
+  // stiffness given).
+  void setup(const Model& model, const ContactParams& params, double penalty, double buffer,
              const std::vector<double>& block_min_height);
   bool needs_detection(const Model& model) const;
   void detect(const Model& model);
@@ -173,9 +174,12 @@ class RigidContact {
     Vec2 fric_b;  // friction part of fb
     double fric_mb = 0.0, fric_ma = 0.0;
     double energy = 0.0, stored = 0.0;
-    Vec2 point;  // G
   };
-  void world_pieces(const Model& model);
+  void detect_at(const Model& model, const std::vector<double>& ux, const std::vector<double>& uy,
+                 const std::vector<double>& theta);
+  // Each outline vertex's displacement (disp_) with the bodies at the poses (ux, uy, theta).
+  void displace_pieces(const Model& model, const std::vector<double>& ux,
+                       const std::vector<double>& uy, const std::vector<double>& theta);
   double piece_gap(Index i, Index j) const;
   bool evaluate(std::size_t p, const Model& model, double dt, bool energy, PairOut& out);
   void pair_constants(const Model& model);
@@ -186,12 +190,11 @@ class RigidContact {
   bool damping_ = false;
   std::vector<double> min_height_;  // per block [m] (penalty mode)
 
-  // Convex pieces: piece k has vertices [piece_first_[k], piece_first_[k + 1]) in ref_x_/ref_y_
-  // (offsets from the body's reference centroid for free blocks, absolute for fixed ones);
-  // block b has pieces [block_piece_[b], block_piece_[b + 1]).
+  // Convex pieces: piece k has vertices [piece_first_[k], piece_first_[k + 1]) of ref_, their
+  // reference positions as the model gives them; block b has pieces [block_piece_[b],
+  // block_piece_[b + 1]).
   std::vector<Index> piece_first_, block_piece_;
-  std::vector<double> ref_x_, ref_y_;
-  std::vector<Vec2> ref_;  // the same vertices' reference positions, as the model gives them
+  std::vector<Vec2> ref_;
   // Current configuration (free blocks rewritten each step): each vertex's displacement from
   // its reference position.
   std::vector<Vec2> disp_;
