@@ -15,6 +15,7 @@
 #include "drivers/dealer.hpp"
 #include "drivers/limit_command.hpp"
 #include "drivers/pulse.hpp"
+#include "drivers/pushover.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/stability.hpp"
 #include "io/deck.hpp"
@@ -128,6 +129,42 @@ int main(int argc, char** argv) {
                        "longest settle under gravity before the trials [s]")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+
+  voussoir::PushoverOptions push_opts;
+  CLI::App* pushover = app.add_subcommand(
+      "pushover",
+      "capacity curve: lambda against a control point's displacement, through the "
+      "peak and down the softening branch, with its equivalent SDOF curve");
+  add_common(pushover, deck, common);
+  voussoir::add_limit_options(pushover, common.limits);
+  pushover->add_option("--control", push_opts.control,
+                       "control block (its centroid); default: the crown block of an arch, the "
+                       "top block otherwise");
+  pushover->add_option("--direction", push_opts.direction, "direction of the load: +x or -x")
+      ->capture_default_str();
+  pushover->add_option("--rate", push_opts.rate,
+                       "speed of the control target [m/s] (default 0.03 sqrt(g L_ref))");
+  pushover->add_option("--max-displacement", push_opts.max_displacement,
+                       "largest control displacement [m] (default half the structure's height)");
+  pushover->add_option("--servo", push_opts.servo,
+                       "servo stiffness K [1/m]: lambda = K (target - d) (default 50 lambda_la "
+                       "/ L_ref)");
+  pushover->add_option("--stop-at", push_opts.stop_at,
+                       "end when lambda has fallen past the peak to this fraction of it (for "
+                       "lambda* alone; default 0: down to lambda <= 0)");
+  pushover->add_flag("--dynamic", push_opts.dynamic,
+                     "physical settle and run: no quasi-static local damping");
+  pushover
+      ->add_option("--settle-time", push_opts.settle_time,
+                   "longest settle under gravity before the pushover [s]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  pushover->add_option("--csv", push_opts.csv, "CSV of the curve and its SDOF curve");
+  pushover->add_option(
+      "--plot", push_opts.plot,
+      "PNG of the curve, the SDOF curve and the mechanism (scripts/plot_pushover)");
+  pushover->add_option("--picture", push_opts.picture,
+                       "picture (PNG/SVG) of the state at the end with its hinges");
 
   voussoir::LimitCommandOptions limit_opts;
   CLI::App* limit =
@@ -249,6 +286,7 @@ int main(int argc, char** argv) {
     if (run->parsed()) return voussoir::command_run(config, common, run_opts);
     if (capacity->parsed()) return voussoir::command_capacity(config, common, cap_opts);
     if (limit->parsed()) return voussoir::command_limit(config, common, limit_opts);
+    if (pushover->parsed()) return voussoir::command_pushover(config, common, push_opts);
     if (pulse->parsed()) {
       pulse_opts.start_given = pulse->count("--start") > 0;
       pulse_opts.tilt_reference_given = pulse->count("--tilt-reference") > 0;
