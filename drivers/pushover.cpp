@@ -204,6 +204,9 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   const double servo = r.servo, rate = r.rate;
   double lambda = 0.0, target = 0.0;
   bool fast = true;
+  // The fast rise ramps lambda_ref on no faster than the capacity trials' ramp.
+  const double fast_rate =
+      std::max(rate, std::min(kFastRate * rate, r.lambda_ref / (servo * set.criteria.ramp_time)));
   auto displacement = [&]() { return dir * (centroid_x(model, k) - x_start); };
   set_static_load(sim, g, 0.0);
   double total_mass = 0.0;
@@ -276,15 +279,15 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
         grab_peak = true;
       }
       const bool past_peak = peak_point + 1 < r.curve.size() && peak_lambda > 0.0;
-      if (past_peak && lambda_qs <= 0.0) stop = true, ended = "lambda <= 0";
-      if (past_peak && set.stop_fraction > 0.0 && lambda_qs <= set.stop_fraction * peak_lambda &&
-          !stop)
+      if (past_peak && quasi_static && lambda_qs <= 0.0) stop = true, ended = "lambda <= 0";
+      if (past_peak && quasi_static && set.stop_fraction > 0.0 &&
+          lambda_qs <= set.stop_fraction * peak_lambda && !stop)
         stop = true, ended = "fallen to " + number(set.stop_fraction) + " x peak";
       win = Window{d, lambda, s_now, e_rate, run_time};
     }
     // The target: fast while lambda is below kFastFraction lambda_ref, at the rate after.
     if (fast && lambda >= kFastFraction * r.lambda_ref) fast = false;
-    target += (fast ? kFastRate : 1.0) * rate * sim_now.ctx.dt;
+    target += (fast ? fast_rate : rate) * sim_now.ctx.dt;
     lambda = servo * (target - d);
     sim_now.ctx.body_ax = dir * lambda * g;
   };
