@@ -53,6 +53,7 @@ void write_csv(const PushoverResult& r, const std::string& path) {
   out << "displacement,lambda,time,d_star,a_star\n";
   for (std::size_t i = 0; i < r.curve.size(); ++i) {
     const PushoverPoint& p = r.curve[i];
+    if (!p.quasi_static) continue;  // a snap's window: in the JSON's "dynamic_windows"
     out << p.displacement << "," << p.lambda << "," << p.time << ",";
     if (r.sdof.valid)
       out << r.sdof.d_star[i] << "," << r.sdof.a_star[i];
@@ -75,9 +76,12 @@ int command_pushover(const Config& config, const CommonOptions& common,
   set.rate = opts.rate;
   set.max_displacement = opts.max_displacement;
   set.servo = opts.servo;
-  if (!(opts.stop_at >= 0.0 && opts.stop_at < 1.0))
-    throw DeckError("--stop-at " + std::to_string(opts.stop_at) +
+  if (!(opts.stop_at >= 0.0 && opts.stop_at < 1.0)) {
+    char v[32];
+    std::snprintf(v, sizeof v, "%g", opts.stop_at);
+    throw DeckError(std::string("--stop-at ") + v +
                     ": must be at least 0 and below 1 (a fraction of the peak)");
+  }
   set.stop_fraction = opts.stop_at;
   set.criteria.quasi_static = !opts.dynamic;
   set.criteria.settle_max_time = opts.settle_time;

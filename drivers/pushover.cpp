@@ -383,13 +383,13 @@ nlohmann::json outlines_json(const Model& m) {
 nlohmann::json pushover_json(const PushoverResult& r) {
   using nlohmann::json;
   const json none(nullptr);
-  json curve = json::array();
+  json curve = json::array(), dynamic = json::array();
   for (const PushoverPoint& p : r.curve)
-    curve.push_back({{"displacement", p.displacement},
-                     {"lambda", p.lambda},
-                     {"lambda_applied", p.applied},
-                     {"quasi_static", p.quasi_static},
-                     {"time", p.time}});
+    (p.quasi_static ? curve : dynamic)
+        .push_back({{"displacement", p.displacement},
+                    {"lambda", p.lambda},
+                    {"lambda_applied", p.applied},
+                    {"time", p.time}});
   json hinges = json::array();
   for (const HingeEvent& e : r.hinges) {
     json h = hinges_to_json({e.hinge})[0];
@@ -401,7 +401,8 @@ nlohmann::json pushover_json(const PushoverResult& r) {
   if (r.sdof.valid) {
     json sc = json::array();
     for (std::size_t i = 0; i < r.sdof.d_star.size(); ++i)
-      sc.push_back({{"d_star", r.sdof.d_star[i]}, {"a_star", r.sdof.a_star[i]}});
+      if (r.curve[i].quasi_static)
+        sc.push_back({{"d_star", r.sdof.d_star[i]}, {"a_star", r.sdof.a_star[i]}});
     sdof = {{"participating_mass_ratio", r.sdof.participating_mass_ratio},
             {"participating_mass", r.sdof.participating_mass},
             {"e_star", r.sdof.participating_mass_ratio},
@@ -415,6 +416,7 @@ nlohmann::json pushover_json(const PushoverResult& r) {
             {"dx", r.sdof.dx}};
   }
   return {{"curve", curve},
+          {"dynamic_windows", dynamic},
           {"peak", {{"lambda", r.peak.lambda}, {"displacement", r.peak.displacement}}},
           {"ultimate_displacement", r.reached_zero ? json(r.ultimate_displacement) : none},
           {"ended", r.ended},

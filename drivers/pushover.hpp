@@ -183,8 +183,9 @@ Sdof equivalent_sdof(const std::vector<double>& weights, const std::vector<doubl
                      const std::vector<PushoverPoint>& curve, double gravity, bool reached_zero,
                      double ultimate_displacement);
 
-// The JSON of SPEC.md section 2 (`pushover --json`), with the block outlines at the peak and
-// at the end under "mechanisms" for scripts/plot_pushover.
+// The JSON of SPEC.md section 2 (`pushover --json`): "curve" holds the quasi-static windows,
+// "dynamic_windows" the others (kDynamicWindow); the block outlines at the peak and at the end
+// under "mechanisms" for scripts/plot_pushover.
 nlohmann::json pushover_json(const PushoverResult& r);
 
 }  // namespace voussoir

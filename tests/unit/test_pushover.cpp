@@ -8,12 +8,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "drivers/pushover.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
+#include "subprocess.hpp"
 
 namespace voussoir {
 namespace {
@@ -239,6 +241,28 @@ TEST(Pushover, BadOptionsNameTheOptionAndValue) {
   EXPECT_NE(message(s).find("--servo -3"), std::string::npos) << message(s);
   s = PushoverSettings{};
   EXPECT_EQ(message(s), "accepted");
+}
+
+// The program: exit status 2 and the option and value named, before any settle.
+TEST(Pushover, CommandRefusesBadOptionsWithStatusTwo) {
+  const std::string deck = std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "voussoir_pushover_cli";
+  std::filesystem::create_directories(dir);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--direction", "y"}, "--direction y"},
+      {{"--rate", "0"}, "--rate 0"},
+      {{"--control", "99"}, "--control 99"},
+      {{"--stop-at", "1"}, "--stop-at 1"}};
+  for (const auto& [args, named] : cases) {
+    std::vector<std::string> all = {VOUSSOIR_BINARY, "pushover", deck, "--quiet"};
+    all.insert(all.end(), args.begin(), args.end());
+    const testing::ProcessResult r = testing::run_process(all, {}, (dir / "child").string());
+    ASSERT_TRUE(r.exited) << r.describe();
+    EXPECT_EQ(r.status, 2) << named << ": " << r.err;
+    EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
