@@ -153,7 +153,10 @@ int main(int argc, char** argv) {
                        "end when lambda has fallen past the peak to this fraction of it (for "
                        "lambda* alone; default 0: down to lambda <= 0)");
   pushover->add_flag("--dynamic", push_opts.dynamic,
-                     "physical settle and run: no quasi-static local damping");
+                     "physical settle and run: no quasi-static local damping (default when the "
+                     "limit-analysis mechanism slides)");
+  pushover->add_flag("--quasi-static", push_opts.quasi_static,
+                     "quasi-static settle and run even when the limit-analysis mechanism slides");
   pushover
       ->add_option("--settle-time", push_opts.settle_time,
                    "longest settle under gravity before the pushover [s]")

@@ -83,7 +83,11 @@ int command_pushover(const Config& config, const CommonOptions& common,
                     ": must be at least 0 and below 1 (a fraction of the peak)");
   }
   set.stop_fraction = opts.stop_at;
-  set.criteria.quasi_static = !opts.dynamic;
+  if (opts.dynamic && opts.quasi_static)
+    throw DeckError(
+        "--dynamic and --quasi-static: give one of them, or neither (the default "
+        "chooses by the limit-analysis mechanism)");
+  set.technique = opts.dynamic ? "dynamic" : opts.quasi_static ? "quasi-static" : "auto";
   set.criteria.settle_max_time = opts.settle_time;
   set.criteria.limits = common.limits;
   const PushoverResult r = run_pushover(config, set, common.quiet);

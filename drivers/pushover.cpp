@@ -154,16 +154,36 @@ Sdof equivalent_sdof(const std::vector<double>& weights, const std::vector<doubl
 PushoverResult run_pushover(const Config& config, const PushoverSettings& given, bool quiet) {
   const auto t0 = Clock::now();
   PushoverSettings set = given;
-  set.criteria.quasi_static = given.criteria.quasi_static;
+  PushoverResult r;
+  // Limit analysis of the same blocks (towards -x: of their mirror image), on the model as
+  // built: lambda_ref for the servo stiffness, and whether the mechanism slides.
+  r.lambda_ref = 1.0;
+  r.lambda_ref_from = "none (1)";
+  bool slides = false;
   {
     // The settings are checked on the model before the settle (exit 2 at once).
     const Simulation probe = make_simulation(config);
     validate_pushover(probe.model, set);
+    const LimitResult la = limit_analysis(set.direction < 0.0 ? mirror_x(probe.model) : probe.model,
+                                          config.contact.friction, config.load.gravity, false);
+    if (la.status == "optimal" && la.lambda_la > 0.0 && std::isfinite(la.lambda_la)) {
+      r.lambda_ref = la.lambda_la;
+      r.lambda_ref_from = "limit analysis";
+      for (const MechanismJoint& j : la.mechanism) slides = slides || j.kind == "sliding";
+    }
+  }
+  // The technique (header comment): quasi-static unless the mechanism slides.
+  if (set.technique == "auto") {
+    set.criteria.quasi_static = !slides;
+    r.technique = slides ? "physical: the limit-analysis mechanism slides"
+                         : "quasi-static: the limit-analysis mechanism does not slide";
+  } else {
+    set.criteria.quasi_static = set.technique == "quasi-static";
+    r.technique = set.technique + " (asked)";
   }
   const SettledState settled = settle(config, set.criteria, quiet);
   if (!settled.settled) throw RunError(unsettled_message(settled, set.criteria));
 
-  PushoverResult r;
   r.settle_wall_s = settled.wall_s;
   r.quasi_static = set.criteria.quasi_static;
   Simulation sim = settled.sim;
@@ -176,19 +196,6 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   r.direction = set.direction;
   r.dt = sim.ctx.dt;
   r.gravity = g;
-
-  // lambda_ref for the servo stiffness: limit analysis of the same blocks (towards -x: of
-  // their mirror image).
-  r.lambda_ref = 1.0;
-  r.lambda_ref_from = "none (1)";
-  if (std::isnan(set.servo)) {
-    const LimitResult la = limit_analysis(set.direction < 0.0 ? mirror_x(model) : model,
-                                          config.contact.friction, g, false);
-    if (la.status == "optimal" && la.lambda_la > 0.0 && std::isfinite(la.lambda_la)) {
-      r.lambda_ref = la.lambda_la;
-      r.lambda_ref_from = "limit analysis";
-    }
-  }
   r.servo = !std::isnan(set.servo) ? set.servo : kServoFactor * r.lambda_ref / l_ref;
   r.rate = !std::isnan(set.rate) ? set.rate : kRateFactor * std::sqrt(std::max(g, 1e-12) * l_ref);
   r.max_displacement = !std::isnan(set.max_displacement)
@@ -238,6 +245,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   const double tol = kHingeFraction * l_ref;
   double peak_lambda = 0.0;
   std::size_t peak_point = 0;
+  std::vector<std::size_t> qs_points;  // indices of the quasi-static windows in r.curve
   bool grab_peak = false, stop = false;
   std::size_t peak_sample = 0;
 
@@ -273,10 +281,20 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
           moved ? (win.work - (e_rate - win.rate_energy)) / (g * ds) : lambda_avg;
       const bool quasi_static = std::abs(lambda_qs - lambda_avg) <= kDynamicWindow * r.lambda_ref;
       r.curve.push_back({d, lambda_qs, run_time, lambda, quasi_static});
-      if (quasi_static && lambda_qs > peak_lambda) {
-        peak_lambda = lambda_qs;
-        peak_point = r.curve.size() - 1;
-        grab_peak = true;
+      if (quasi_static) {
+        // The peak: the largest median of three consecutive quasi-static windows, at the
+        // middle one (one window's spike is not a peak).
+        qs_points.push_back(r.curve.size() - 1);
+        const std::size_t m = qs_points.size();
+        if (m >= 3) {
+          const double a = r.curve[qs_points[m - 3]].lambda, b = r.curve[qs_points[m - 2]].lambda;
+          const double median = std::max(std::min(a, b), std::min(std::max(a, b), lambda_qs));
+          if (median > peak_lambda) {
+            peak_lambda = median;
+            peak_point = qs_points[m - 2];
+            grab_peak = true;
+          }
+        }
       }
       const bool past_peak = peak_point + 1 < r.curve.size() && peak_lambda > 0.0;
       if (past_peak && quasi_static && lambda_qs <= 0.0) stop = true, ended = "lambda <= 0";
@@ -327,6 +345,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   if (r.at_peak.blocks.empty()) r.at_peak = model;
   r.hinges_at_end = find_hinges(model, tol, tol);
   r.peak = r.curve[peak_point];
+  r.peak.lambda = peak_lambda;
   if (ended == "lambda <= 0") {  // the last two points bracket lambda = 0
     const PushoverPoint &a = r.curve[r.curve.size() - 2], &b = r.curve.back();
     r.reached_zero = true;
@@ -428,6 +447,7 @@ nlohmann::json pushover_json(const PushoverResult& r) {
           {"lambda_ref_from", r.lambda_ref_from},
           {"max_displacement", r.max_displacement},
           {"quasi_static", r.quasi_static},
+          {"technique", r.technique},
           {"sdof", sdof},
           {"hinges", hinges},
           {"energy_balance_error", r.energy_balance_error},

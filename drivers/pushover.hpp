@@ -48,11 +48,20 @@
 // On the semicircular arch at the default rate the applied lambda overshoots the peak by 3.4%,
 // lambda_qs peaks at lambda* of `capacity` to 1e-4 (docs/pushover.md).
 //
-// Quasi-static technique (TrialCriteria::quasi_static, the default, off with --dynamic): the
-// settle and the run take Cundall's local damping of capacity.local_damping and, for rigid
-// blocks, the settle's mass scaling. The kinetic damping of the capacity trials is not used:
-// it stops every motion at each peak of the kinetic energy, which a mechanism driven at a
-// constant rate reaches at every sample. Default rate: kRateFactor sqrt(g L_ref). On the
+// Technique. Quasi-static (as the capacity trials): Cundall's local damping of
+// capacity.local_damping and, for rigid blocks, the settle's mass scaling. The kinetic damping
+// of the capacity trials is not used: it stops every motion at each peak of the kinetic
+// energy, which a mechanism driven at a constant rate reaches at every sample. On a sliding
+// mechanism the quasi-static run misreads the statics: the peak of the semicircular arch of
+// embrace 120 and friction 0.6 came out 16% above capacity's lambda* (and above the limit
+// analysis that bounds it; the likely cause, not proven: under the local damping the slide
+// goes by jerks, whose friction work counts as statics), 0.2% above it in the physical run (no
+// local damping or mass scaling; the joints' default dashpot). The default ("auto") therefore runs
+// the physical pushover when the limit-analysis mechanism slides, the quasi-static one otherwise
+// (the physical run costs 2 to 5 times as much: the physical step, and the structure's ringing);
+// --dynamic and --quasi-static force one.
+//
+// Default rate: kRateFactor sqrt(g L_ref). On the
 // semicircular arch 0.75 and 0.375 times it give the same peak to 1e-4 and the same curve to
 // 1e-3 x lambda* down to lambda = 0; 1.125 times it the same peak and ultimate displacement;
 // 1.5 times it a spurious peak 13% high from a dynamic window (docs/pushover.md).
@@ -89,7 +98,7 @@ inline constexpr double kFastRate = 10.0;     // x v, while lambda < kFastFracti
 inline constexpr double kFastFraction = 0.5;
 // A window whose quasi-static load factor differs from the applied one by more than this x
 // lambda_ref is dynamic (a snap, a block falling): in the curve, not a candidate for the peak.
-inline constexpr double kDynamicWindow = 0.25;
+inline constexpr double kDynamicWindow = 0.1;
 inline constexpr double kMechanismWindow = 0.1;  // of the way from the peak to the end
 // A window of the quasi-static load factor closes when d has moved kWindowDisplacement x
 // L_ref, the applied lambda has moved kWindowLambda x lambda_ref, or after kWindowTime.
@@ -112,7 +121,10 @@ struct PushoverSettings {
   double servo = kDefault;             // [1/m] K; kServoFactor lambda_ref / L_ref
   // > 0: end when lambda has fallen to this fraction of the peak past the peak (lambda* alone)
   double stop_fraction = 0.0;
-  TrialCriteria criteria;  // the settle's (quasi_static, settle_max_time, limits)
+  // "auto": quasi-static unless the limit-analysis mechanism slides; "quasi-static";
+  // "dynamic" (the physical run)
+  std::string technique = "auto";
+  TrialCriteria criteria;  // the settle's settle_max_time and limits (quasi_static: technique)
 };
 
 // The crown block of an arch (the highest voussoir), or the top free block otherwise: the
@@ -155,7 +167,7 @@ struct PushoverResult {
   double rate = 0.0, max_displacement = 0.0, servo = 0.0, lambda_ref = 0.0;
   std::string lambda_ref_from;       // "limit analysis" or "none (1)"
   std::vector<PushoverPoint> curve;  // every sample from the settled state
-  PushoverPoint peak;
+  PushoverPoint peak;                // its lambda: the median of its window and the two around
   bool reached_zero = false;
   double ultimate_displacement = 0.0;  // d0 [m] where lambda reaches 0 (when reached_zero)
   // "lambda <= 0", "fallen to F x peak", "max displacement", "time limit"
@@ -169,6 +181,7 @@ struct PushoverResult {
   double dt = 0.0;
   double gravity = 9.81;  // [m/s2]
   bool quasi_static = true;
+  std::string technique;  // which, and why
   // The model at the peak and at the end (nodes where they were) for the pictures.
   Model at_peak, at_end;
   std::vector<Hinge> hinges_at_end;
@@ -201,7 +214,8 @@ struct PushoverOptions {
   double max_displacement = kDefault;  // --max-displacement D [m]
   double servo = kDefault;             // --servo K [1/m]
   double stop_at = 0.0;                // --stop-at F: end at F x the peak past it
-  bool dynamic = false;                // --dynamic: no quasi-static damping
+  bool dynamic = false;                // --dynamic: the physical run
+  bool quasi_static = false;           // --quasi-static: quasi-static even if it slides
   double settle_time = 5.0;            // --settle-time [s]
   std::string csv;                     // --csv FILE: the curve and its SDOF curve
   std::string plot;                    // --plot FILE.png (scripts/plot_pushover)
