@@ -40,6 +40,7 @@ void print_pushover(const PushoverResult& r, const std::string& deck) {
     if (!h.side.empty()) std::printf(", pivot at %s", h.side.c_str());
     std::printf(": opened at d = %.4g m, lambda = %.4f\n", e.displacement, e.lambda);
   }
+  std::printf("technique: %s\n", r.technique.c_str());
   std::printf(
       "%zu points, %.3f s simulated in %lld steps, servo K = %.4g /m, rate %.4g m/s, "
       "energy balance error %.2g, %.1f s wall\n",
