@@ -245,7 +245,8 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   const double tol = kHingeFraction * l_ref;
   double peak_lambda = 0.0;
   std::size_t peak_point = 0;
-  std::vector<std::size_t> qs_points;  // indices of the quasi-static windows in r.curve
+  // Indices of the quasi-static windows in r.curve (the first point, at rest, is one).
+  std::vector<std::size_t> qs_points = {0};
   bool grab_peak = false, stop = false;
   std::size_t peak_sample = 0;
 
@@ -274,7 +275,8 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
     const bool full = std::abs(d - win.d) >= d_window ||
                       std::abs(lambda - win.lambda) >= lambda_window ||
                       run_time - win.time >= kWindowTime;
-    if ((full && moved) || run_time - win.time >= kWindowMaxTime) {
+    // After the window that ends the run, none more: the engine stops at its next sample.
+    if (!stop && ((full && moved) || run_time - win.time >= kWindowMaxTime)) {
       const double e_rate = rate_energy(sim_now.ledger);
       const double lambda_avg = win.lambda_sum / static_cast<double>(win.steps);
       const double lambda_qs =
@@ -323,7 +325,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
       grab_peak = false;
     }
     for (const Hinge& h : find_hinges(s.model, tol, tol))
-      if (seen.insert(h.joint).second) r.hinges.push_back({h, d, r.curve.back().lambda});
+      if (seen.insert(h.joint).second) r.hinges.push_back({h, d, r.curve[qs_points.back()].lambda});
     if (stop) return false;
     if (d >= r.max_displacement) {
       ended = "max displacement";
@@ -346,8 +348,9 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   r.hinges_at_end = find_hinges(model, tol, tol);
   r.peak = r.curve[peak_point];
   r.peak.lambda = peak_lambda;
-  if (ended == "lambda <= 0") {  // the last two points bracket lambda = 0
-    const PushoverPoint &a = r.curve[r.curve.size() - 2], &b = r.curve.back();
+  if (ended == "lambda <= 0") {  // the last two quasi-static windows bracket lambda = 0
+    const std::size_t m = qs_points.size();
+    const PushoverPoint &a = r.curve[qs_points[m - 2]], &b = r.curve[qs_points[m - 1]];
     r.reached_zero = true;
     r.ultimate_displacement =
         a.lambda > b.lambda
