@@ -1,5 +1,6 @@
-// Earthquake records (io/accelerogram: the PEER AT2 reader, the baseline correction) against
-// hand-written files. The figures printed here are quoted in docs/records.md:
+// Earthquake records (io/accelerogram: the PEER AT2 reader, the baseline correction) and their
+// response spectra (core/spectrum: exact integration of the piecewise-linear record) against
+// hand-written files and closed forms. The figures printed here are quoted in docs/records.md:
 //   build/test_records   (or: ctest --test-dir build -R Records -V)
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "core/base_motion.hpp"
+#include "core/spectrum.hpp"
 #include "io/accelerogram.hpp"
 
 namespace voussoir {
@@ -179,6 +181,86 @@ TEST(RecordsBaseline, RemovesAnOffsetAndALinearDrift) {
   base.signal = "windowed_sine";
   base.baseline = "linear";
   EXPECT_THROW(make_base_signal(base, kG), DeckError);
+}
+
+// (a) Harmonic base acceleration a_g = A sin(w_g t). The oscillator u'' + 2 z w u' + w^2 u =
+// -a_g settles to u = -A / w^2 H sin(w_g t - phi) with the dynamic amplification
+//     H = 1 / sqrt((1 - r^2)^2 + (2 z r)^2),   r = w_g / w,
+// so its steady pseudo-acceleration is Sa = w^2 max|u| = A H. The transient decays as
+// e^{-z w t}: over 60 s it is below e^{-0.05 pi 60} = 8e-5 of its start for T <= 2 s; the peak
+// is read over the last 20 s of an 80 s record, at dt = 0.002 s (500 samples a cycle).
+TEST(RecordsSpectrum, HarmonicSteadyStateAmplitude) {
+  const double a = 1.0, tg = 1.0, wg = 2.0 * kPi / tg, dt = 0.002, z = 0.05;
+  std::vector<double> acc(40001);
+  for (std::size_t k = 0; k < acc.size(); ++k) acc[k] = a * std::sin(wg * dt * double(k));
+  for (double period : {0.25, 0.5, 0.9, 1.0, 1.1, 2.0}) {
+    const double w = 2.0 * kPi / period, r = wg / w;
+    const double closed = a / std::sqrt((1 - r * r) * (1 - r * r) + (2 * z * r) * (2 * z * r));
+    const double sa = w * w * sdof_peak_displacement(acc, dt, period, z, 30000, acc.size());
+    std::printf("harmonic: T = %.2f s (r = %.2f): Sa = %.6f, closed form %.6f, error %.2e\n",
+                period, r, sa, closed, sa / closed - 1.0);
+    EXPECT_NEAR(sa / closed, 1.0, 1e-3);  // the contract: 1%
+  }
+}
+
+// (b) Ramped step, z = 0: a_g rises linearly from 0 to A over t_r, then stays. With
+// w_r = w t_r, during the ramp u = -(A / w^2) (t / t_r - sin(w t) / w_r); after it
+//     u = -(A / w^2) [1 + (sin w (t - t_r) - sin w t) / w_r],
+// whose oscillating part has amplitude 2 |sin(w t_r / 2)| / w_r, so
+//     Sa = w^2 max|u| = A (1 + |sin(pi t_r / T)| / (pi t_r / T))
+// (the dynamic amplification of a ramp, Chopra 4.5). The ramp is exactly piecewise linear on
+// the samples (t_r a multiple of dt), so only the reading of the peak at samples errs.
+TEST(RecordsSpectrum, RampedStepPeak) {
+  const double a = 2.0, dt = 0.001, period = 1.0;
+  for (double tr : {0.2, 0.5, 0.75, 1.0, 1.6, 3.3}) {
+    const std::size_t nr = static_cast<std::size_t>(std::lround(tr / dt));
+    std::vector<double> acc(nr + 3000);
+    for (std::size_t k = 0; k < acc.size(); ++k) acc[k] = k < nr ? a * double(k) / double(nr) : a;
+    const double x = kPi * tr / period;
+    const double closed = a * (1.0 + std::abs(std::sin(x)) / x);
+    const double w = 2.0 * kPi / period;
+    const double sa = w * w * sdof_peak_displacement(acc, dt, period, 0.0, 0, acc.size());
+    std::printf("ramp: t_r / T = %.2f: Sa / A = %.6f, closed form %.6f, error %.2e\n", tr / period,
+                sa / a, closed / a, sa / closed - 1.0);
+    EXPECT_NEAR(sa / closed, 1.0, 1e-6);  // the contract: 1%
+  }
+}
+
+// (c) T -> 0: the stiff oscillator follows the base, Sa -> PGA. A two-sine record (1.3 and
+// 2.9 Hz) at dt = 0.005 s: at T = 0.02 s the quasi-static error is about (2.9 T)^2 ~ 0.3%.
+TEST(RecordsSpectrum, ShortPeriodsGiveThePga) {
+  std::vector<double> acc(2001);
+  for (std::size_t k = 0; k < acc.size(); ++k) {
+    const double t = 0.005 * double(k);
+    acc[k] = 0.3 * std::sin(2 * kPi * 1.3 * t) + 0.2 * std::sin(2 * kPi * 2.9 * t + 0.4);
+  }
+  double pga = 0.0;
+  for (double x : acc) pga = std::max(pga, std::abs(x));
+  const std::vector<double> periods = {0.001, 0.005, 0.02};
+  const std::vector<double> sa = response_spectrum(acc, 0.005, periods);
+  for (std::size_t i = 0; i < periods.size(); ++i)
+    std::printf("short periods: T = %.3f s: Sa / PGA = %.6f\n", periods[i], sa[i] / pga);
+  EXPECT_NEAR(sa[0] / pga, 1.0, 1e-3);
+  EXPECT_NEAR(sa[1] / pga, 1.0, 5e-3);
+  EXPECT_NEAR(sa[2] / pga, 1.0, 0.01);
+}
+
+// The step matrices of an undamped oscillator against the closed form of one step:
+// u1 = p1/k + (u0 - p0/k) cos wh + (v0 - (p1 - p0)/(k h)) sin(wh) / w, k = w^2.
+TEST(RecordsSpectrum, UndampedStepMatrices) {
+  const double w = 3.0, h = 0.1, k = w * w, c = std::cos(w * h), s = std::sin(w * h);
+  const SdofStep m = make_sdof_step(w, 0.0, h);
+  EXPECT_NEAR(m.a00, c, 1e-14);
+  EXPECT_NEAR(m.a01, s / w, 1e-14);
+  EXPECT_NEAR(m.b00, (-c + s / (w * h)) / k, 1e-14);
+  EXPECT_NEAR(m.b01, (1.0 - s / (w * h)) / k, 1e-14);
+  EXPECT_NEAR(m.a10, -w * s, 1e-14);
+  EXPECT_NEAR(m.a11, c, 1e-14);
+  const std::vector<double> t = log_spaced_periods(0.02, 4.0, 100);
+  ASSERT_EQ(t.size(), 100u);
+  EXPECT_DOUBLE_EQ(t.front(), 0.02);
+  EXPECT_DOUBLE_EQ(t.back(), 4.0);
+  EXPECT_NEAR(t[1] / t[0], t[99] / t[98], 1e-12);
 }
 
 }  // namespace
