@@ -18,6 +18,7 @@
 #include "core/base_motion.hpp"
 #include "core/spectrum.hpp"
 #include "io/accelerogram.hpp"
+#include "subprocess.hpp"
 
 namespace voussoir {
 namespace {
@@ -261,6 +262,58 @@ TEST(RecordsSpectrum, UndampedStepMatrices) {
   EXPECT_DOUBLE_EQ(t.front(), 0.02);
   EXPECT_DOUBLE_EQ(t.back(), 4.0);
   EXPECT_NEAR(t[1] / t[0], t[99] / t[98], 1e-12);
+}
+
+// `voussoir pulse DECK --spectrum F.csv --spectrum-only` on an AT2 record: the CSV of 100
+// periods from 0.02 to 4 s, Sa(0.02 s) close to the PGA; a malformed record and
+// --spectrum-only without --spectrum exit 2 (the record's message names file and line).
+TEST(RecordsSpectrum, PulseWritesTheSpectrumCsv) {
+  std::string values;
+  for (int k = 0; k < 400; ++k) {
+    char v[32];
+    std::snprintf(v, sizeof v, " %.7E%s", 0.2 * std::sin(2 * kPi * 2.0 * 0.01 * k),
+                  k % 5 == 4 ? "\n" : "");
+    values += v;
+  }
+  const std::string rec =
+      write_file("cli.AT2", std::string(kHeader3) + "NPTS=   400, DT=   .0100 SEC\n" + values);
+  const std::string csv = (temp_dir() / "spectrum.csv").string();
+  const std::string deck = std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml";
+  auto pulse = [&](const std::string& file, std::vector<std::string> extra) {
+    std::vector<std::string> args = {VOUSSOIR_BINARY,
+                                     "pulse",
+                                     deck,
+                                     "--set",
+                                     "load.base.signal=\"file\"",
+                                     "--set",
+                                     "load.base.file=\"" + file + "\""};
+    args.insert(args.end(), extra.begin(), extra.end());
+    testing::Limits limits;
+    limits.wall_s = 30;
+    return testing::run_process(args, limits, (temp_dir() / "child").string());
+  };
+  testing::ProcessResult r = pulse(rec, {"--spectrum", csv, "--spectrum-only"});
+  ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "period,sa_g");
+  std::vector<double> period, sa;
+  while (std::getline(in, line)) {
+    period.push_back(std::stod(line));
+    sa.push_back(std::stod(line.substr(line.find(',') + 1)));
+  }
+  ASSERT_EQ(period.size(), 100u);
+  EXPECT_NEAR(period.front(), 0.02, 1e-12);
+  EXPECT_NEAR(period.back(), 4.0, 1e-12);
+  EXPECT_NEAR(sa.front() / 0.2, 1.0, 0.02);  // 2 Hz at T = 0.02 s: quasi-static
+  const std::string bad = write_file("bad.AT2", std::string(kHeader3) + "NPTS= 9, DT= .01\n1 2\n");
+  r = pulse(bad, {"--spectrum", csv, "--spectrum-only"});
+  EXPECT_TRUE(r.exited && r.status == 2) << r.describe();
+  EXPECT_NE(r.err.find("bad.AT2:5:"), std::string::npos) << r.err;
+  r = pulse(rec, {"--spectrum-only"});
+  EXPECT_TRUE(r.exited && r.status == 2) << r.describe();
+  std::filesystem::remove_all(temp_dir());
 }
 
 }  // namespace
