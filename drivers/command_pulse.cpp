@@ -82,6 +82,8 @@ void write_spectrum(const Config& config, const PulseOptions& opts) {
       log_spaced_periods(kSpectrumFirst, kSpectrumLast, kSpectrumPeriods);
   const std::vector<double> sa =
       response_spectrum(signal.samples(), signal.sample_dt(), periods, kSpectrumDamping);
+  // Under mpirun (pulse --curve) every rank reads and checks the record; rank 0 writes.
+  if (!is_dealer_rank()) return;
   const double g = config.load.gravity;
   std::size_t top = 0;
   for (std::size_t i = 0; i < sa.size(); ++i)
