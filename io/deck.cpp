@@ -615,7 +615,7 @@ void check_together(const Reader& r, Config& c) {
   if (c.load.base.signal == "file" && !given("load.base.file"))
     throw DeckError(r.where("load.base.signal", r.seen.at("load.base.signal")) +
                     "missing required key 'load.base.file' (load.base.signal = \"file\" reads a "
-                    "two-column accelerogram from it)");
+                    "two-column or PEER .AT2 accelerogram from it)");
   // Input files the run will read must be there now, not an hour into a sweep.
   auto readable = [&](const std::string& key, const std::string& path) {
     std::error_code ec;
