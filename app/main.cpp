@@ -218,6 +218,13 @@ int main(int argc, char** argv) {
                     "trend [s] (default 1.5)");
   pulse->add_option("--tilt-reference", pulse_opts.tilt_reference,
                     "a measured tilting capacity to report lambda* against");
+  pulse->add_option("--spectrum", pulse_opts.spectrum,
+                    "CSV of the 5%-damped pseudo-acceleration spectrum of the base signal "
+                    "(period,sa_g; docs/records.md), written before the run");
+  pulse->add_option("--spectrum-plot", pulse_opts.spectrum_plot,
+                    "PNG of that spectrum (scripts/plot_spectrum; needs --spectrum)");
+  pulse->add_flag("--spectrum-only", pulse_opts.spectrum_only,
+                  "write the spectrum and stop (no simulation)");
 
   voussoir::SweepOptions sweep_opts;
   CLI::App* sweep = app.add_subcommand("sweep", "capacity over a grid of deck values");

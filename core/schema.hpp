@@ -102,6 +102,10 @@ struct BaseConfig {
   std::string file;                    // accelerogram (time, acceleration)
   std::string units = "g";             // of the file's acceleration column: "g" or "m/s2"
   std::array<double, 2> band = {0.0, 0.0};  // band-pass [Hz]; {0,0} = no filter
+  // baseline correction of the file record before the band-pass (io/accelerogram.hpp):
+  // "none", or the degree of the polynomial removed from the acceleration: "constant",
+  // "linear", "quadratic"
+  std::string baseline = "none";
 };
 
 struct LoadConfig {

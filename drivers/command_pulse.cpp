@@ -11,6 +11,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "core/spectrum.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/dealer.hpp"
 #include "drivers/plot.hpp"
@@ -62,6 +63,47 @@ SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {
     r.control_displacements.push_back(s.control_uy[p]);
   }
   return r;
+}
+
+// --spectrum: the 5%-damped pseudo-acceleration spectrum (core/spectrum.hpp) of the signal the
+// run uses (read, baseline-corrected, band-passed and scaled as make_base_signal gives it), at
+// kSpectrumPeriods periods log-spaced over [kSpectrumFirst, kSpectrumLast] s; CSV period,sa_g.
+constexpr double kSpectrumFirst = 0.02;  // [s]
+constexpr double kSpectrumLast = 4.0;    // [s]
+constexpr int kSpectrumPeriods = 100;
+constexpr double kSpectrumDamping = 0.05;
+
+void write_spectrum(const Config& config, const PulseOptions& opts) {
+  const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
+  if (signal.kind() == BaseSignal::Kind::None)
+    throw DeckError(config.deck_path +
+                    ": load.base.signal = \"none\": --spectrum needs a base signal");
+  const std::vector<double> periods =
+      log_spaced_periods(kSpectrumFirst, kSpectrumLast, kSpectrumPeriods);
+  const std::vector<double> sa =
+      response_spectrum(signal.samples(), signal.sample_dt(), periods, kSpectrumDamping);
+  // Under mpirun (pulse --curve) every rank reads and checks the record; rank 0 writes.
+  if (!is_dealer_rank()) return;
+  const double g = config.load.gravity;
+  std::size_t top = 0;
+  for (std::size_t i = 0; i < sa.size(); ++i)
+    if (sa[i] > sa[top]) top = i;
+  {
+    std::ofstream csv(opts.spectrum);
+    if (!csv) throw OutputError(opts.spectrum + ": cannot write the spectrum CSV");
+    csv.precision(9);
+    csv << "period,sa_g\n";
+    for (std::size_t i = 0; i < sa.size(); ++i) csv << periods[i] << "," << sa[i] / g << "\n";
+    if (!csv.flush()) throw OutputError(opts.spectrum + ": cannot write the spectrum CSV");
+  }
+  std::printf("spectrum (%.0f%% damping) of %s: PGA %.4g g, peak Sa %.4g g at T = %.3g s; %s\n",
+              100.0 * kSpectrumDamping,
+              config.load.base.signal == "file" ? config.load.base.file.c_str()
+                                                : config.load.base.signal.c_str(),
+              signal.peak_acceleration() / g, sa[top] / g, periods[top], opts.spectrum.c_str());
+  if (!opts.spectrum_plot.empty())
+    draw_with_script("plot_spectrum", {opts.spectrum, "-o", opts.spectrum_plot},
+                     opts.spectrum_plot);
 }
 
 int single_run(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
@@ -448,6 +490,11 @@ int command_pulse(const Config& config, const CommonOptions& common, const Pulse
   if (opts.curve && !opts.picture.empty())
     throw DeckError("--picture draws a single pulse run's final state: not with --curve (the "
                     "curve's picture is --plot)");
+  if (opts.spectrum.empty() && (opts.spectrum_only || !opts.spectrum_plot.empty()))
+    throw DeckError(std::string(opts.spectrum_only ? "--spectrum-only" : "--spectrum-plot") +
+                    " needs --spectrum FILE.csv");
+  if (!opts.spectrum.empty()) write_spectrum(config, opts);
+  if (opts.spectrum_only) return 0;
   return opts.curve ? curve_run(config, common, opts) : single_run(config, common, opts);
 }
 

@@ -217,6 +217,9 @@ struct PulseOptions {
   double tilt_reference = 0.0;  // --tilt-reference X: a measured tilting capacity to compare
   bool tilt_reference_given = false;
   std::string resume;           // --resume FILE: journal of the curve's runs (and FILE.capacity)
+  std::string spectrum;         // --spectrum FILE.csv: response spectrum of the base signal
+  std::string spectrum_plot;    // --spectrum-plot FILE.png (scripts/plot_spectrum)
+  bool spectrum_only = false;   // --spectrum-only: write the spectrum, run nothing
 };
 
 // Checks the options (the curve's search and frequencies with --curve): DeckError (exit 2)

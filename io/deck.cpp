@@ -381,6 +381,7 @@ const std::vector<KeySpec>& key_table() {
       {"load.base.cycles", [](Reader& r, const toml::node& n, Config& c) { c.load.base.cycles = r.integer(n, 1, 1000); }},
       {"load.base.file", [](Reader& r, const toml::node& n, Config& c) { c.load.base.file = r.input_file(n); }},
       {"load.base.units", [](Reader& r, const toml::node& n, Config& c) { c.load.base.units = r.choice(n, {"g", "m/s2"}); }},
+      {"load.base.baseline", [](Reader& r, const toml::node& n, Config& c) { c.load.base.baseline = r.choice(n, {"none", "constant", "linear", "quadratic"}); }},
       {"load.base.band", [](Reader& r, const toml::node& n, Config& c) {
          const char* what = "[low, high] in Hz with 0 <= low < high, or [0, 0] for no filter";
          const toml::array& a = r.array(n, what);
@@ -614,7 +615,7 @@ void check_together(const Reader& r, Config& c) {
   if (c.load.base.signal == "file" && !given("load.base.file"))
     throw DeckError(r.where("load.base.signal", r.seen.at("load.base.signal")) +
                     "missing required key 'load.base.file' (load.base.signal = \"file\" reads a "
-                    "two-column accelerogram from it)");
+                    "two-column or PEER .AT2 accelerogram from it)");
   // Input files the run will read must be there now, not an hour into a sweep.
   auto readable = [&](const std::string& key, const std::string& path) {
     std::error_code ec;

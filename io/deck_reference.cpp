@@ -94,8 +94,13 @@ const std::map<std::string, std::string>& meanings() {
       {"load.base.amplitude", "peak base acceleration A"},
       {"load.base.frequency", "pulse frequency f"},
       {"load.base.cycles", "windowed sine: number of cycles"},
-      {"load.base.file", "signal = \"file\": two-column accelerogram (time, acceleration)"},
+      {"load.base.file",
+       "signal = \"file\": two-column accelerogram (time, acceleration) or PEER NGA .AT2 "
+       "record (docs/records.md)"},
       {"load.base.units", "units of the accelerogram's acceleration column"},
+      {"load.base.baseline",
+       "baseline correction of the accelerogram before the band-pass: the degree of the "
+       "polynomial removed from the acceleration, fitted to the displacement (docs/records.md)"},
       {"load.base.band", "band-pass filter of the accelerogram [low, high] ([0, 0]: none)"},
       // [capacity]
       {"capacity.lambda_min", "lower end of the starting bracket of `capacity` (stable)"},
@@ -196,6 +201,7 @@ std::string default_of(const std::string& key) {
       {"load.base.cycles", std::to_string(c.load.base.cycles)},
       {"load.base.file", "none"},
       {"load.base.units", quoted(c.load.base.units)},
+      {"load.base.baseline", quoted(c.load.base.baseline)},
       {"load.base.band", list(c.load.base.band, number)},
       {"capacity.lambda_min", number(c.capacity.lambda_min)},
       {"capacity.lambda_max", number(c.capacity.lambda_max)},

@@ -86,6 +86,7 @@ cycles = 4
 file = "quake.csv"
 units = "m/s2"
 band = [0.5, 25]
+baseline = "linear"
 
 [capacity]
 lambda_min = 0.1
@@ -193,6 +194,7 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_EQ(c.load.base.units, "m/s2");
   EXPECT_DOUBLE_EQ(c.load.base.band[0], 0.5);
   EXPECT_DOUBLE_EQ(c.load.base.band[1], 25.0);
+  EXPECT_EQ(c.load.base.baseline, "linear");
   EXPECT_DOUBLE_EQ(c.capacity.lambda_min, 0.1);
   EXPECT_DOUBLE_EQ(c.capacity.lambda_max, 1.5);
   EXPECT_DOUBLE_EQ(c.capacity.tolerance, 0.01);
@@ -380,6 +382,8 @@ TEST(DeckErrors, OutOfRange) {
                     {"load.base.signal = \"earthquake\"", "windowed_sine"});
   expect_deck_error(std::string(kMinimal) + "[load.base]\nunits = \"ft/s2\"\n",
                     {"load.base.units = \"ft/s2\"", "\"m/s2\""});
+  expect_deck_error(std::string(kMinimal) + "[load.base]\nbaseline = \"cubic\"\n",
+                    {"load.base.baseline = \"cubic\"", "\"quadratic\""});
   expect_deck_error(std::string(kMinimal) + "[material]\nplane = \"3d\"\n",
                     {"material.plane = \"3d\"", "\"strain\""});
   expect_deck_error("[model]\nkind = \"arch\"\n", {"model.kind = \"arch\"", "circular_arch"});
