@@ -137,6 +137,10 @@ int main(int argc, char** argv) {
                   "only decide whether an admissible equilibrium exists under self-weight");
   limit->add_option("--mechanism-out", limit_opts.mechanism_out,
                     "write the block polygons and the mechanism as JSON (scripts/draw)");
+  limit
+      ->add_option("--thrust", limit_opts.thrust,
+                   "least (min) or greatest (max) horizontal support thrust under gravity")
+      ->check(CLI::IsMember({"min", "max"}));
 
   voussoir::PulseOptions pulse_opts;
   CLI::App* pulse = app.add_subcommand(
