@@ -95,7 +95,90 @@ SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) 
                  "energy balance error %.2g)\n",
                  s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"),
                  s.settle_time, s.steps, sim.ctx.dt, s.wall_s, sim.ledger.balance_error());
+  if (s.settled && !sim.supports.empty()) move_supports_settled(s, config, crit, quiet);
   return s;
+}
+
+MotionExtent support_allowance(const SupportMotion& supports, double l_ref) {
+  double reach = 0.0, turn = 0.0;
+  for (const SupportMove& m : supports.moves) {
+    reach = std::max(reach, std::hypot(m.dx, m.dy));
+    turn = std::max(turn, std::abs(m.rotation));
+  }
+  return {3.0 * reach, 3.0 * reach / l_ref + turn};
+}
+
+Outcome run_support_movement(Simulation& sim, double gravity, double l_ref, double ramp,
+                             const MotionExtent& allowed, const TrialCriteria& crit, bool quiet) {
+  const double v_rest = crit.rest_speed * std::sqrt(std::max(gravity, 1e-12) * l_ref);
+  const double d_collapse = crit.collapse_displacement * l_ref;
+  auto phase = [&](const char* label, double end_time, bool hold) {
+    RunSpec spec;
+    spec.label = label;
+    spec.loads = LoadProgram{};
+    spec.loads->gravity = gravity;
+    spec.limits = crit.limits;
+    spec.end_time = end_time;
+    spec.track_motion = true;
+    const double widen = hold ? 0.0 : 1.0;
+    spec.rules.push_back(
+        std::make_unique<CollapseRule>(d_collapse + widen * allowed.displacement,
+                                       crit.collapse_rotation + widen * allowed.rotation));
+    if (hold) spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, 0.0));
+    spec.quiet = quiet;
+    spec.progress = [label](const Probe& p, double wall) {
+      std::fprintf(stderr, "  %s: %.3f s, largest block motion %.3g m, %.3g rad (%.0f s wall)\n",
+                   label, p.time, p.motion.displacement, p.motion.rotation, wall);
+    };
+    return run_engine(sim, spec);
+  };
+  // The ramp without the quasi-static damping, which would hold back the blocks the supports
+  // carry (docs/supports.md "Why the ramp is undamped").
+  const double local = sim.ctx.local_damping, kinetic = sim.ctx.kinetic_damping;
+  sim.ctx.local_damping = sim.ctx.kinetic_damping = 0.0;
+  Outcome o = phase("moving the supports", ramp, false);
+  sim.ctx.local_damping = local, sim.ctx.kinetic_damping = kinetic;
+  std::fill(sim.local_damping_previous.begin(), sim.local_damping_previous.end(), 0.0);
+  sim.kinetic_peak = 0.0;
+  if (o.decided) return o;
+  const Outcome held = phase("holding the moved supports", crit.settle_max_time, true);
+  o.decided = held.decided, o.collapsed = held.collapsed, o.reason = held.reason;
+  o.time += held.time;
+  o.decided_at = o.time - held.time + held.decided_at;
+  o.steps += held.steps;
+  o.wall_s += held.wall_s;
+  o.motion = held.motion;
+  return o;
+}
+
+// The support movement after the settle ([supports], core/supports.hpp), by
+// run_support_movement. Nothing to run when every move is zero.
+void move_supports_settled(SettledState& s, const Config& config, const TrialCriteria& crit,
+                           bool quiet) {
+  const auto t0 = Clock::now();
+  Simulation& sim = s.sim;
+  const MotionExtent allowed = support_allowance(sim.supports, s.l_ref);
+  const double ramp = config.supports.ramp;
+  start_supports(config, sim);
+  if (allowed.displacement == 0.0 && allowed.rotation == 0.0) return;
+  const Outcome o = run_support_movement(sim, s.gravity, s.l_ref, ramp, allowed, crit, quiet);
+  s.settled = o.decided && !o.collapsed;
+  s.collapsed = o.decided && o.collapsed;
+  s.supports_collapsed = s.collapsed;
+  s.supports_time = o.time;
+  s.max_displacement = o.motion.displacement;
+  s.max_rotation = o.motion.rotation;
+  set_static_load(sim, s.gravity, 0.0);
+  s.settle_time = sim.ctx.time;
+  s.steps = sim.step;
+  s.wall_s += seconds_since(t0);
+  if (!quiet)
+    std::fprintf(stderr,
+                 "supports moved (%zu, over %.3g s): %s after %.3f s (%lld steps in all, %.2f s "
+                 "wall; energy balance error %.2g)\n",
+                 sim.supports.moves.size(), ramp,
+                 s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"), o.time,
+                 s.steps, s.wall_s, sim.ledger.balance_error());
 }
 
 Model mirror_x(const Model& model) {
@@ -113,7 +196,13 @@ Model mirror_x(const Model& model) {
 
 std::string unsettled_message(const SettledState& s, const TrialCriteria& crit) {
   char buf[320];
-  if (s.collapsed)
+  if (s.supports_collapsed)
+    std::snprintf(buf, sizeof buf,
+                  "the structure collapses while its supports move ([supports]): a block moved "
+                  "%.3g m and rotated %.3g rad within %.3g s of the movement's start (no "
+                  "capacity left, lambda* = 0)",
+                  s.max_displacement, s.max_rotation, s.supports_time);
+  else if (s.collapsed)
     std::snprintf(buf, sizeof buf,
                   "the structure collapses under gravity alone: a block moved %.3g m and "
                   "rotated %.3g rad within %.3g s of settling (no gravity capacity, "

@@ -114,12 +114,40 @@ struct SettledState {
   bool collapsed = false;              // a block passed the collapse criterion while settling
   double max_displacement = 0.0;       // [m] largest block motion while settling
   double max_rotation = 0.0;           // [rad]
+  // [supports]: the movement's run time [s] (settle_time includes it), and whether the
+  // structure collapsed while the supports moved (then `collapsed` too)
+  double supports_time = 0.0;
+  bool supports_collapsed = false;
 };
 
 // Settles the model of `config` under gravity (lambda = 0): until rest (the trial criteria's
 // rest rule), a collapse (their displacement or rotation rule: no gravity capacity), or
-// `settle_max_time`.
+// `settle_max_time`. With [supports] moves, once at rest the supports move over
+// supports.ramp and the structure is held until rest again (move_supports_settled): every
+// analysis that starts from this state (capacity, sweep, pulse) runs on the moved structure.
 SettledState settle(const Config& config, const TrialCriteria& criteria, bool quiet);
+
+// What a support movement may move the free blocks by without a collapse: the moved blocks
+// carry the structure with them, so the collapse limits of the phases in which supports move
+// add the largest support displacement |d| times 3 (a three-hinge mechanism turns the
+// movement of a support into a larger one of the crown) to the displacement limit [m], and
+// 3 |d| / L_ref plus the largest prescribed rotation to the rotation limit [rad].
+MotionExtent support_allowance(const SupportMotion& supports, double l_ref);
+
+// A support movement already started on `sim` (core/supports.hpp start_support_motion or
+// retarget_support_motion at sim.ctx.time) under gravity: the ramp over `ramp` seconds, with
+// the quasi-static local and kinetic damping off (they act on absolute velocities and would
+// hold back the blocks the supports carry: the blocks slid on their moving supports) and the
+// collapse limits widened by `allowed` (support_allowance); then, the damping back on, held
+// until rest (the settle's rest rule) or the settle's time limit, collapse limits as settled
+// and motion measured from the end of the ramp. Outcome: decided and not collapsed = at rest.
+Outcome run_support_movement(Simulation& sim, double gravity, double l_ref, double ramp,
+                             const MotionExtent& allowed, const TrialCriteria& criteria,
+                             bool quiet);
+
+// The support movement of `settle` on a settled state (run_support_movement).
+void move_supports_settled(SettledState& settled, const Config& config,
+                           const TrialCriteria& criteria, bool quiet);
 
 // The block outlines and joints of `model` mirrored about x = 0 (outlines counter-clockwise):
 // what limit analysis reads, so that its lambda towards +x is the original's towards -x.
