@@ -13,6 +13,7 @@
 #include "core/supports.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/spread.hpp"
 #include "drivers/thrust.hpp"
 #include "io/deck.hpp"
 #include "limit/limit_analysis.hpp"
@@ -133,6 +134,31 @@ TEST(SupportsAcceptance, SpreadArchCarriesTheLeastThrustPushedTheGreatest) {
         s.wall_s);
     EXPECT_NEAR(h, la.thrust, 0.03 * la.thrust) << d;
   }
+}
+
+// The spreading study (drivers/spread.hpp) on the same arch, its left support moved out in
+// two steps of 5.5 mm (0.25% of the width): at rest each time, on three hinges, its thrust
+// within 3% of the least thrust and growing with the spread (the arch flattens); the CSV and
+// the JSON carry every state.
+TEST(Spread, ArchOnASpreadingSupportKeepsTheLeastThrustAndThreeHinges) {
+  const Config config = load_deck(case_path("circular_arch"), {"supports.ramp=0.2"});
+  SpreadOptions opts;
+  opts.step = 0.0055;
+  opts.max_movement = 0.011;
+  const SpreadResult r = run_spread(config, opts, true);
+  EXPECT_EQ(r.block, 11);
+  EXPECT_EQ(r.direction.x, -1.0);
+  EXPECT_FALSE(r.collapsed);
+  ASSERT_EQ(r.states.size(), 3u);  // the settled state and two steps
+  for (std::size_t k = 1; k < r.states.size(); ++k) {
+    const SpreadState& s = r.states[k];
+    ASSERT_FALSE(s.collapsed) << k;
+    EXPECT_NEAR(s.thrust, r.thrust_min, 0.03 * r.thrust_min) << k;
+    EXPECT_NEAR(s.thrust_left, s.thrust_right, 1e-3 * s.thrust) << k;
+    EXPECT_EQ(s.hinges.size(), 3u) << k;
+  }
+  EXPECT_GT(r.states[2].thrust, r.states[1].thrust);
+  EXPECT_NEAR(r.states[2].movement, 0.011, 1e-15);
 }
 
 }  // namespace
