@@ -9,11 +9,12 @@
 #include <exception>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
-#include <nlohmann/json.hpp>
 
 #include "core/fnv.hpp"
+#include "core/rigid.hpp"
 #include "drivers/bracket.hpp"
 #include "drivers/journal.hpp"
 #include "drivers/motion.hpp"
@@ -192,6 +193,48 @@ Model mirror_x(const Model& model) {
     j.b.x = -j.b.x;
   }
   return m;
+}
+
+MovedBlocks moved_blocks(const Simulation& sim, bool mirror) {
+  Model reference = sim.model;
+  sync_rigid_nodes(reference);
+  const std::vector<BlockMotion> motion = block_motions(reference);
+  MovedBlocks out;
+  out.model = reference;
+  for (std::size_t b = 0; b < motion.size(); ++b)
+    for (Vec2& p : out.model.blocks[b].polygon) p = move_point(motion[b], p);
+  auto carried = [&](Index a, Index b, Vec2 p) {
+    return 0.5 * (move_point(motion[std::size_t(a)], p) + move_point(motion[std::size_t(b)], p));
+  };
+  for (Joint& j : out.model.joints) {
+    j.a = carried(j.block_a, j.block_b, j.a);
+    j.b = carried(j.block_a, j.block_b, j.b);
+  }
+  for (Interface f : find_interfaces(sim.model)) {
+    const double turn =
+        0.5 * (motion[std::size_t(f.block_a)].rotation + motion[std::size_t(f.block_b)].rotation);
+    const double c = std::cos(turn), s = std::sin(turn);
+    f.a = carried(f.block_a, f.block_b, f.a);
+    f.b = carried(f.block_a, f.block_b, f.b);
+    f.normal = {c * f.normal.x - s * f.normal.y, s * f.normal.x + c * f.normal.y};
+    out.interfaces.push_back(f);
+  }
+  if (mirror) {
+    out.model = mirror_x(out.model);
+    for (Interface& f : out.interfaces) f.a.x = -f.a.x, f.b.x = -f.b.x, f.normal.x = -f.normal.x;
+  }
+  return out;
+}
+
+LimitResult limit_of_settled(const SettledState& settled, double friction, double direction) {
+  const Simulation& sim = settled.sim;
+  if (sim.supports.empty())
+    return limit_analysis(direction < 0.0 ? mirror_x(sim.model) : sim.model, friction,
+                          settled.gravity, false);
+  const MovedBlocks moved = moved_blocks(sim, direction < 0.0);
+  LimitOptions options;
+  options.interfaces = &moved.interfaces;
+  return limit_analysis(moved.model, friction, settled.gravity, false, options);
 }
 
 std::string unsettled_message(const SettledState& s, const TrialCriteria& crit) {
@@ -519,9 +562,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     if (!have_hi) lo = hi;
   } else if (search.seed_from_limit) {
     // Towards -x: limit analysis of the mirror image towards +x.
-    const LimitResult la = limit_analysis(
-        crit.direction < 0.0 ? mirror_x(settled.sim.model) : settled.sim.model,
-        config.contact.friction, settled.gravity, false);
+    const LimitResult la = limit_of_settled(settled, config.contact.friction, crit.direction);
     res.seed.status = la.status;
     if (la.status == "optimal" && la.lambda_la > lo) {
       res.seed.used = true;

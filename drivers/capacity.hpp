@@ -53,6 +53,7 @@
 #include "drivers/kinematics.hpp"
 #include "drivers/thrust.hpp"
 #include "drivers/trial.hpp"
+#include "limit/limit_analysis.hpp"
 
 namespace voussoir {
 
@@ -153,6 +154,28 @@ void move_supports_settled(SettledState& settled, const Config& config,
 // what limit analysis reads, so that its lambda towards +x is the original's towards -x.
 // Nodes and triangles are copied unchanged.
 Model mirror_x(const Model& model);
+
+// The blocks of a simulation where they are, for limit analysis of a structure whose supports
+// moved: every outline (and joint) carried by its block's rigid motion (drivers/kinematics.hpp
+// block_motions), and the interfaces of the reference outlines, each end carried by the mean
+// of its two blocks' motions and its normal turned by their mean rotation (an open hinge's
+// faces no longer meet face to face, so find_interfaces would not find them; the joint gaps
+// are a small fraction of the joint length), so the LP takes every joint as closed. Tried and
+// rejected: an open hinge (find_hinges, kHingeFraction L_ref) kept as a point contact at its
+// pivot. A symmetric spread opens both joints of the crown block, and the LP then sees a
+// four-hinge chain: lambda_la = 1e-6 on the semicircular arch spread by 0.5% to 2% of its
+// span, where the FDEM arch carries 0.26 to 0.29 (docs/supports.md). `mirror`: mirrored about
+// x = 0 (mirror_x), for the load towards -x.
+struct MovedBlocks {
+  Model model;
+  std::vector<Interface> interfaces;
+};
+MovedBlocks moved_blocks(const Simulation& sim, bool mirror = false);
+
+// Limit analysis (lambda_la towards +x, or towards -x when direction < 0) of the blocks of a
+// settled state: of the reference outlines when no support moved (bit for bit the plain
+// limit_analysis), else of moved_blocks.
+LimitResult limit_of_settled(const SettledState& settled, double friction, double direction);
 
 // Why a settle did not end at rest, for the error of the commands that need rest.
 std::string unsettled_message(const SettledState& settled, const TrialCriteria& criteria);

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "drivers/capacity.hpp"
 #include "drivers/limit_command.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
@@ -93,7 +94,20 @@ nlohmann::json interfaces_json(const LimitResult& res) {
 int command_limit(const Config& config, const CommonOptions& common,
                   const LimitCommandOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Model model = build_model(scene_params(config));
+  // [supports]: the blocks where the support movement leaves them (settled under gravity and
+  // moved as `capacity` does it, then carried rigidly: drivers/capacity.hpp moved_blocks).
+  MovedBlocks moved;
+  LimitOptions options;
+  if (!config.supports.moves.empty()) {
+    TrialCriteria crit;
+    crit.quasi_static = true;
+    const SettledState settled = settle(config, crit, common.quiet);
+    if (!settled.settled)
+      throw RunError(config.deck_path + ": " + unsettled_message(settled, crit));
+    moved = moved_blocks(settled.sim);
+    options.interfaces = &moved.interfaces;
+  }
+  const Model model = options.interfaces ? moved.model : build_model(scene_params(config));
   const double model_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double mu = config.contact.friction;
@@ -110,9 +124,9 @@ int command_limit(const Config& config, const CommonOptions& common,
   const bool thrust = !opts.thrust.empty();
   const std::string thrust_key = "thrust_" + opts.thrust;
   const LimitResult res =
-      thrust
-          ? limit_thrust(model, mu, g, opts.thrust == "min" ? ThrustBound::Min : ThrustBound::Max)
-          : limit_analysis(model, mu, g, opts.gravity_only);
+      thrust ? limit_thrust(model, mu, g,
+                            opts.thrust == "min" ? ThrustBound::Min : ThrustBound::Max, options)
+             : limit_analysis(model, mu, g, opts.gravity_only, options);
 
   std::printf("deck        %s\n", config.deck_path.c_str());
   std::printf("model       %s: %d free blocks, %zu interfaces (mu = %.4g)\n", model.kind.c_str(),

@@ -226,7 +226,7 @@ int command_spread(const Config& config, const CommonOptions& common, const Spre
                   st->thrust_right, hinge_text(st->hinges).c_str());
   }
   if (r.collapsed)
-    std::printf("collapse    at a movement in [%.6g, %.6g] m (%.4g%% of the free width bracket)\n",
+    std::printf("collapse    at a movement in [%.6g, %.6g] m (bracket %.3g%% of its upper end)\n",
                 r.collapse_lo, r.collapse_hi,
                 100.0 * (r.collapse_hi - r.collapse_lo) / std::max(r.collapse_hi, 1e-300));
   else

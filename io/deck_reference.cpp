@@ -53,8 +53,9 @@ const std::map<std::string, std::string>& meanings() {
        "narrower (refused naming the file's line, the block and the vertex; format: "
        "mesh/scenes_polygons.cpp)"},
       {"model.fixed",
-       "polygons: indices of the fixed blocks (file order; gmsh: physical tag order); at least "
-       "one block must stay free"},
+       "polygons: indices of the fixed blocks (file order; gmsh: physical tag order); other "
+       "kinds: blocks fixed besides the scene's supports (a pier to settle with [supports]); "
+       "at least one block must stay free"},
       {"model.out_of_plane", "out-of-plane thickness: masses and forces scale with it"},
       // [mesh]
       {"mesh.chord_tolerance",

@@ -153,7 +153,9 @@ LimitResult solve_limit_lp(const Model& model, double mu, double gravity, Object
   auto scaled = [&](Vec2 p) { return Vec2{(p.x - origin.x) / length, (p.y - origin.y) / length}; };
 
   // Interfaces that touch a free block.
-  for (const Interface& f : find_interfaces(model, options.interface_tol))
+  const std::vector<Interface> found =
+      options.interfaces ? std::vector<Interface>{} : find_interfaces(model, options.interface_tol);
+  for (const Interface& f : options.interfaces ? *options.interfaces : found)
     if (!model.blocks[f.block_a].fixed || !model.blocks[f.block_b].fixed)
       res.interfaces.push_back(f);
   const Index ni = static_cast<Index>(res.interfaces.size());

@@ -80,6 +80,11 @@ struct LimitOptions {
   // is taken as not moving in the mechanism.
   double motion_tol = 1e-6;
   double interface_tol = 1e-9;  // find_interfaces rel_tol
+  // The interfaces to use instead of find_interfaces (null: found from the outlines). For
+  // blocks whose outlines no longer meet face to face: a structure whose supports moved opens
+  // its hinges, and its joints are then the reference ones carried with their blocks
+  // (drivers/capacity.hpp moved_blocks).
+  const std::vector<Interface>* interfaces = nullptr;
 };
 
 // Maximises lambda such that every free block is in equilibrium under its weight W = rho A

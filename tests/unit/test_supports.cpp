@@ -161,5 +161,36 @@ TEST(Spread, ArchOnASpreadingSupportKeepsTheLeastThrustAndThreeHinges) {
   EXPECT_NEAR(r.states[2].movement, 0.011, 1e-15);
 }
 
+// model.fixed on a generated scene fixes the listed blocks besides its supports (a church
+// pier to settle); an index out of range is a bad deck.
+TEST(Supports, ModelFixedMakesAnyBlockASupport) {
+  const Model m = build_model(scene_params(load_deck(case_path("church_b"), {"model.fixed=[1]"})));
+  EXPECT_TRUE(m.blocks[1].fixed);
+  EXPECT_EQ(m.blocks[1].role, "pier");
+  EXPECT_FALSE(m.blocks[2].fixed);
+  EXPECT_THROW(
+      build_model(scene_params(load_deck(case_path("circular_arch"), {"model.fixed=[99]"}))),
+      DeckError);
+}
+
+// Limit analysis of the moved blocks: with supports that did not move, the carried outlines
+// and interfaces give back the reference lambda_la; spread by 1 cm, a lower one.
+TEST(Supports, LimitAnalysisOfTheMovedBlocks) {
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  const Config still = load_deck(case_path("circular_arch"), {"supports.moves=[{block = 11}]"});
+  const SettledState s0 = settle(still, crit, true);
+  ASSERT_TRUE(s0.settled);
+  const double reference =
+      limit_analysis(build_model(scene_params(still)), 0.6, 9.81, false).lambda_la;
+  EXPECT_NEAR(limit_of_settled(s0, 0.6, 1.0).lambda_la, reference, 1e-3 * reference);
+  EXPECT_NEAR(limit_of_settled(s0, 0.6, -1.0).lambda_la, reference, 1e-3 * reference);
+  const SettledState s1 = settle(load_deck(case_path("circular_arch"), spread(0.005)), crit, true);
+  ASSERT_TRUE(s1.settled);
+  const double moved = limit_of_settled(s1, 0.6, 1.0).lambda_la;
+  EXPECT_LT(moved, reference);
+  EXPECT_GT(moved, 0.9 * reference);
+}
+
 }  // namespace
 }  // namespace voussoir
