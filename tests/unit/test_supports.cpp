@@ -1,11 +1,14 @@
-// Supports that move ([supports], core/supports.hpp): the ramp, a moved rigid support reaching
-// its pose exactly, the deck's refusals (exit status 2 naming key and value), and the
-// acceptance of issue 45: the semicircular arch (rigid blocks) with its supports spread apart
-// carries the least thrust of limit analysis, pushed together the greatest.
+// Supports that move ([supports], core/supports.hpp): the ramp, moved rigid and elastic
+// supports reaching their pose exactly with the energy ledger balanced, the deck's refusals
+// (exit status 2 naming key and value), model.fixed on generated scenes, limit analysis of the
+// moved blocks, the acceptance of issue 45 (the semicircular arch, rigid blocks, with its
+// supports spread apart carries the least thrust of limit analysis, pushed together the
+// greatest), and the spreading study (drivers/spread.hpp) and its command.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -74,6 +77,34 @@ TEST(Supports, RigidSupportReachesItsPoseAndTheLedgerBalances) {
   EXPECT_NEAR(sim.model.nodes.x[i], r.cx[11] + c * r.rx[i] - s * r.ry[i], 1e-15);
   EXPECT_LT(worst, 0.01) << "energy balance error";
   EXPECT_GT(sim.ledger.external_work, 0.0);
+}
+
+TEST(Supports, ElasticSupportReachesItsPoseAndTheLedgerBalances) {
+  // The same with elastic blocks: the support's nodes at their pose, the broad phase following
+  // them, the ledger within 1%.
+  const Config config = load_deck(
+      case_path("circular_arch"),
+      {"material.model=elastic", "supports.moves=[{block = 11, dx = -0.006, rotation = 0.1}]",
+       "supports.ramp=0.01"});
+  Simulation sim = make_simulation(config);
+  start_support_motion(sim.supports, 0.0, config.supports.ramp);
+  set_static_load(sim, config.load.gravity, 0.0);
+  double worst = 0.0;
+  while (sim.ctx.time < 0.015) {
+    advance(sim);
+    if (sim.step > 1000) worst = std::max(worst, sim.ledger.balance_error());
+  }
+  const Block& b = sim.model.blocks[11];
+  const Vec2 c0 = sim.supports.centroid[0];
+  const double th = 0.1 * M_PI / 180.0;
+  for (Index i = b.first_node; i < b.first_node + b.node_count; ++i) {
+    const double rx = sim.model.nodes.x0[i] - c0.x, ry = sim.model.nodes.y0[i] - c0.y;
+    EXPECT_NEAR(sim.model.nodes.x[i], c0.x - 0.006 + std::cos(th) * rx - std::sin(th) * ry, 1e-15);
+    EXPECT_NEAR(sim.model.nodes.y[i], c0.y + std::sin(th) * rx + std::cos(th) * ry, 1e-15);
+    EXPECT_EQ(sim.model.nodes.vx[i], 0.0);
+  }
+  EXPECT_LT(worst, 0.01) << "energy balance error";
+  EXPECT_GT(sim.contact.detections(), 1);
 }
 
 TEST(Supports, DeckRefusalsNameKeyAndValue) {
@@ -190,6 +221,26 @@ TEST(Supports, LimitAnalysisOfTheMovedBlocks) {
   const double moved = limit_of_settled(s1, 0.6, 1.0).lambda_la;
   EXPECT_LT(moved, reference);
   EXPECT_GT(moved, 0.9 * reference);
+}
+
+// `voussoir spread` writes its table, CSV and JSON.
+TEST(Spread, CommandWritesCsvAndJson) {
+  const std::string dir = ::testing::TempDir();
+  const testing::ProcessResult p =
+      testing::run_process({VOUSSOIR_BINARY, "spread", case_path("circular_arch"), "--quiet",
+                            "--step", "0.0055", "--max", "0.0055", "--set", "supports.ramp=0.2",
+                            "--csv", dir + "spread.csv", "--json", dir + "spread.json"},
+                           {}, dir + "spread_cmd");
+  ASSERT_TRUE(p.exited && p.status == 0) << p.describe() << p.err;
+  EXPECT_NE(p.out.find("collapse    none up to 0.0055 m"), std::string::npos) << p.out;
+  const std::string csv = testing::read_text_file(dir + "spread.csv");
+  EXPECT_EQ(csv.rfind("movement,collapsed,thrust,thrust_left,thrust_right,hinges", 0), 0u);
+  const nlohmann::json j = nlohmann::json::parse(testing::read_text_file(dir + "spread.json"));
+  EXPECT_EQ(j.at("block"), 11);
+  EXPECT_EQ(j.at("states").size(), 2u);
+  EXPECT_TRUE(j.at("collapse_movement").is_null());
+  EXPECT_NEAR(j.at("thrust_min").get<double>(), 1848.55, 0.01);
+  EXPECT_EQ(j.at("states")[1].at("hinges").size(), 3u);
 }
 
 }  // namespace
