@@ -17,6 +17,7 @@
 #include "drivers/pulse.hpp"
 #include "drivers/pushover.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/spread.hpp"
 #include "drivers/stability.hpp"
 #include "io/deck.hpp"
 #include "io/deck_reference.hpp"
@@ -177,6 +178,37 @@ int main(int argc, char** argv) {
                   "only decide whether an admissible equilibrium exists under self-weight");
   limit->add_option("--mechanism-out", limit_opts.mechanism_out,
                     "write the block polygons and the mechanism as JSON (scripts/draw)");
+  limit
+      ->add_option("--thrust", limit_opts.thrust,
+                   "least (min) or greatest (max) horizontal support thrust under gravity")
+      ->check(CLI::IsMember({"min", "max"}));
+
+  voussoir::SpreadOptions spread_opts;
+  CLI::App* spread = app.add_subcommand(
+      "spread", "move a support step by step until the structure collapses: thrust, hinges");
+  add_common(spread, deck, common);
+  voussoir::add_limit_options(spread, common.limits);
+  spread->add_option("--block", spread_opts.block,
+                     "fixed block to move (default: the deck's first move, else the leftmost)");
+  spread
+      ->add_option("--direction", spread_opts.direction,
+                   "DX,DY of the movement (default: horizontal, away from the structure)")
+      ->delimiter(',')
+      ->expected(2);
+  spread->add_option("--rotation", spread_opts.rotation,
+                     "turn of the support [deg] per metre of movement");
+  spread->add_option("--step", spread_opts.step, "movement per step [m] (default 0.25% of width)")
+      ->check(CLI::NonNegativeNumber);
+  spread
+      ->add_option("--max", spread_opts.max_movement,
+                   "largest movement [m] (default 25% of the structure's width)")
+      ->check(CLI::NonNegativeNumber);
+  spread
+      ->add_option("--tolerance", spread_opts.tolerance,
+                   "relative width of the bracket on the movement at collapse")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-4, 1.0));
+  spread->add_option("--csv", spread_opts.csv, "thrust and hinges per step")->capture_default_str();
 
   voussoir::PulseOptions pulse_opts;
   CLI::App* pulse = app.add_subcommand(
@@ -297,6 +329,7 @@ int main(int argc, char** argv) {
     if (capacity->parsed()) return voussoir::command_capacity(config, common, cap_opts);
     if (limit->parsed()) return voussoir::command_limit(config, common, limit_opts);
     if (pushover->parsed()) return voussoir::command_pushover(config, common, push_opts);
+    if (spread->parsed()) return voussoir::command_spread(config, common, spread_opts);
     if (pulse->parsed()) {
       pulse_opts.start_given = pulse->count("--start") > 0;
       pulse_opts.tilt_reference_given = pulse->count("--tilt-reference") > 0;

@@ -45,7 +45,8 @@ Participants select_participants(const Model& model) {
     p.tri.push_back(e);
     p.block.push_back(t.block[e]);
     p.fixed.push_back(fixed ? 1 : 0);
-    if (!fixed) {
+    // The nodes watched against the buffer: those of free blocks and of supports that move.
+    if (!fixed || model.blocks[t.block[e]].prescribed) {
       p.free_nodes.push_back(t.n0[e]);
       p.free_nodes.push_back(t.n1[e]);
       p.free_nodes.push_back(t.n2[e]);

@@ -73,7 +73,8 @@ struct Participants {
   std::vector<Index> tri;           // triangle id
   std::vector<Index> block;         // owning block
   std::vector<std::uint8_t> fixed;  // 1 when the block is fixed
-  std::vector<Index> free_nodes;    // distinct nodes of participants of free blocks, ascending
+  std::vector<Index> free_nodes;    // distinct nodes of participants of free blocks and of
+                                    // supports that move (Block::prescribed), ascending
 
   Index size() const { return static_cast<Index>(tri.size()); }
 };

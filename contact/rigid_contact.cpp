@@ -99,6 +99,13 @@ inline void half_angle(double theta, double& s, double& c) {
   }
 }
 
+// Does block b have a pose of its own: a free body, or a support whose movement [supports]
+// prescribes (core/supports.hpp)? Fixed blocks that stay put keep their reference outline.
+inline bool has_pose(const Model& model, std::size_t b) {
+  const Block& blk = model.blocks[b];
+  return (!blk.fixed || blk.prescribed) && model.rigid.mass[b] > 0.0;
+}
+
 // Is the counter-clockwise polygon convex (collinear vertices allowed)?
 bool is_convex(const std::vector<Vec2>& v) {
   const std::size_t n = v.size();
@@ -321,7 +328,7 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
   longest_side_.assign(nb, 0.0);
   for (std::size_t b = 0; b < nb; ++b) {
     const Block& blk = model.blocks[b];
-    const bool moves = !blk.fixed && r.mass.size() == nb && r.mass[b] > 0.0;
+    const bool moves = (!blk.fixed || blk.prescribed) && r.mass.size() == nb && r.mass[b] > 0.0;
     const Vec2 origin = moves ? Vec2{r.cx0[b], r.cy0[b]} : Vec2{};
     const std::vector<Vec2>& poly = blk.polygon;
     for (std::size_t k = 0; k < poly.size(); ++k)
@@ -385,7 +392,7 @@ bool RigidContact::needs_detection(const Model& model) const {
   const double half = 0.5 * broad_.buffer();
   const std::size_t nb = model.blocks.size();
   for (std::size_t b = 0; b < nb; ++b) {
-    if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
+    if (!has_pose(model, b)) continue;
     const double dx = r.ux[b] - ref_ux_[b], dy = r.uy[b] - ref_uy_[b];
     const double moved =
         std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
@@ -407,7 +414,7 @@ void RigidContact::detect_at(const Model& model, const std::vector<double>& ux,
   // Node positions from the bodies (the outline triangles' corners).
   for (std::size_t b = 0; b < nb; ++b) {
     const Block& blk = model.blocks[b];
-    if (blk.fixed || !(r.mass[b] > 0.0)) continue;
+    if (!has_pose(model, b)) continue;
     const double c = std::cos(theta[b]), s = std::sin(theta[b]);
     const double cx = r.cx0[b] + ux[b], cy = r.cy0[b] + uy[b];
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
@@ -543,7 +550,7 @@ void RigidContact::displace_pieces(const Model& model, const std::vector<double>
   const RigidBodies& r = model.rigid;
   const std::size_t nb = model.blocks.size();
   for (std::size_t b = 0; b < nb; ++b) {
-    if (model.blocks[b].fixed || !(r.mass[b] > 0.0)) continue;
+    if (!has_pose(model, b)) continue;
     // Displacement of each vertex, u = (c - c0) + (R - I) r with cos - 1 = -2 sin^2(theta/2):
     // small numbers computed to their own round-off.
     double sh, ch;
@@ -698,7 +705,7 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, boo
     for (std::size_t b = 0; b < nb; ++b) {
       const double* f = &now[3 * b];
       double* g = &prev[3 * b];
-      if (!model.blocks[b].fixed && r.mass[b] > 0.0)
+      if (has_pose(model, b))
         work += (f[0] + g[0]) * r.vx[b] + (f[1] + g[1]) * r.vy[b] + (f[2] + g[2]) * r.omega[b];
       g[0] = f[0], g[1] = f[1], g[2] = f[2];
       now[3 * b] = now[3 * b + 1] = now[3 * b + 2] = 0.0;

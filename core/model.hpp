@@ -102,6 +102,9 @@ struct Triangles {
 
 struct Block {
   bool fixed = false;
+  // A fixed block whose movement [supports] prescribes (core/supports.hpp): the step puts it
+  // where the movement says, and contact detection follows it as it does a free block.
+  bool prescribed = false;
   std::string role;                  // "voussoir", "abutment", "buttress", "ground", ...
   std::string name;                  // name in the source file (gmsh physical), or empty
   std::vector<Vec2> polygon;         // outline, counter-clockwise [m]

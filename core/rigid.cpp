@@ -146,7 +146,7 @@ void sync_rigid_nodes(Model& model) {
   const RigidBodies& r = model.rigid;
   for (std::size_t b = 0; b < model.blocks.size(); ++b) {
     const Block& blk = model.blocks[b];
-    if (blk.fixed || !(r.mass[b] > 0.0)) continue;
+    if ((blk.fixed && !blk.prescribed) || !(r.mass[b] > 0.0)) continue;  // supports that move
     const double cs = std::cos(r.theta[b]), sn = std::sin(r.theta[b]);
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
       const double ox = cs * r.rx[i] - sn * r.ry[i], oy = sn * r.rx[i] + cs * r.ry[i];

@@ -134,6 +134,19 @@ struct CapacityConfig {
   std::string mass_scaling = "equalize";
 };
 
+// [supports]: prescribed movements of fixed blocks (SPEC section 3; core/supports.hpp).
+struct SupportMoveConfig {
+  int block = 0;          // index of a fixed block (as `check --mesh-out` numbers them)
+  double dx = 0.0;        // displacement of the block [m]
+  double dy = 0.0;        // [m]
+  double rotation = 0.0;  // counter-clockwise about the block's centroid [deg]
+};
+
+struct SupportsConfig {
+  std::vector<SupportMoveConfig> moves;  // empty: the supports stay where they are
+  double ramp = 0.5;  // [s] over which the moves are reached after the settle under gravity
+};
+
 struct OutputConfig {
   std::string file;                    // HDF5 path; empty = no HDF5 output
   double every = 0.01;                 // snapshot interval [s]
@@ -150,6 +163,7 @@ struct Config {
   SolverConfig solver;
   LoadConfig load;
   CapacityConfig capacity;
+  SupportsConfig supports;
   OutputConfig output;
 };
 

@@ -14,6 +14,7 @@
 #include "core/integrate.hpp"
 #include "core/loads.hpp"
 #include "core/rigid.hpp"
+#include "core/supports.hpp"
 
 namespace voussoir {
 
@@ -188,6 +189,10 @@ void advance(Simulation& sim) {
     kinetic -= removed;
   }
   clock.stamp(timers.integrate);
+
+  // 7. prescribed supports: their work over the step, then their pose at t^(n+1)
+  if (!sim.supports.empty())
+    ledger.external_work += move_supports(model, sim.supports, ctx.time + ctx.dt, ctx.dt);
 
   // Energy ledger.
   ledger.kinetic = kinetic;

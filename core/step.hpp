@@ -12,6 +12,8 @@
 //   6. central-difference integration (v then x), kinetic energy   core/integrate, core/rigid
 //      (with the local damping of the quasi-static phases when ctx.local_damping > 0, and
 //      their kinetic damping when ctx.kinetic_damping > 0)
+//   7. prescribed supports: their work over the step, then their   core/supports
+//      pose at the step's end (only with [supports] moves)
 
 #include <array>
 #include <vector>
@@ -20,6 +22,7 @@
 #include "core/cst.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
+#include "core/supports.hpp"
 
 namespace voussoir {
 
@@ -81,6 +84,9 @@ struct Simulation {
   long long kinetic_resets = 0;
   // Scratch of the threaded element stage (core/cst.hpp), built at the first large step.
   ElementWorkspace element_work;
+  // Prescribed movement of fixed blocks ([supports]; empty: none), started by the drivers
+  // after the settle under gravity (core/supports.hpp).
+  SupportMotion supports;
 };
 
 // Fills ctx law constants and eta from the model material and damping factor.

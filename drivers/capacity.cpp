@@ -9,11 +9,12 @@
 #include <exception>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
-#include <nlohmann/json.hpp>
 
 #include "core/fnv.hpp"
+#include "core/rigid.hpp"
 #include "drivers/bracket.hpp"
 #include "drivers/journal.hpp"
 #include "drivers/motion.hpp"
@@ -95,7 +96,90 @@ SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) 
                  "energy balance error %.2g)\n",
                  s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"),
                  s.settle_time, s.steps, sim.ctx.dt, s.wall_s, sim.ledger.balance_error());
+  if (s.settled && !sim.supports.empty()) move_supports_settled(s, config, crit, quiet);
   return s;
+}
+
+MotionExtent support_allowance(const SupportMotion& supports, double l_ref) {
+  double reach = 0.0, turn = 0.0;
+  for (const SupportMove& m : supports.moves) {
+    reach = std::max(reach, std::hypot(m.dx, m.dy));
+    turn = std::max(turn, std::abs(m.rotation));
+  }
+  return {3.0 * reach, 3.0 * reach / l_ref + turn};
+}
+
+Outcome run_support_movement(Simulation& sim, double gravity, double l_ref, double ramp,
+                             const MotionExtent& allowed, const TrialCriteria& crit, bool quiet) {
+  const double v_rest = crit.rest_speed * std::sqrt(std::max(gravity, 1e-12) * l_ref);
+  const double d_collapse = crit.collapse_displacement * l_ref;
+  auto phase = [&](const char* label, double end_time, bool hold) {
+    RunSpec spec;
+    spec.label = label;
+    spec.loads = LoadProgram{};
+    spec.loads->gravity = gravity;
+    spec.limits = crit.limits;
+    spec.end_time = end_time;
+    spec.track_motion = true;
+    const double widen = hold ? 0.0 : 1.0;
+    spec.rules.push_back(
+        std::make_unique<CollapseRule>(d_collapse + widen * allowed.displacement,
+                                       crit.collapse_rotation + widen * allowed.rotation));
+    if (hold) spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, 0.0));
+    spec.quiet = quiet;
+    spec.progress = [label](const Probe& p, double wall) {
+      std::fprintf(stderr, "  %s: %.3f s, largest block motion %.3g m, %.3g rad (%.0f s wall)\n",
+                   label, p.time, p.motion.displacement, p.motion.rotation, wall);
+    };
+    return run_engine(sim, spec);
+  };
+  // The ramp without the quasi-static damping, which would hold back the blocks the supports
+  // carry (docs/supports.md "Why the ramp is undamped").
+  const double local = sim.ctx.local_damping, kinetic = sim.ctx.kinetic_damping;
+  sim.ctx.local_damping = sim.ctx.kinetic_damping = 0.0;
+  Outcome o = phase("moving the supports", ramp, false);
+  sim.ctx.local_damping = local, sim.ctx.kinetic_damping = kinetic;
+  std::fill(sim.local_damping_previous.begin(), sim.local_damping_previous.end(), 0.0);
+  sim.kinetic_peak = 0.0;
+  if (o.decided) return o;
+  const Outcome held = phase("holding the moved supports", crit.settle_max_time, true);
+  o.decided = held.decided, o.collapsed = held.collapsed, o.reason = held.reason;
+  o.time += held.time;
+  o.decided_at = o.time - held.time + held.decided_at;
+  o.steps += held.steps;
+  o.wall_s += held.wall_s;
+  o.motion = held.motion;
+  return o;
+}
+
+// The support movement after the settle ([supports], core/supports.hpp), by
+// run_support_movement. Nothing to run when every move is zero.
+void move_supports_settled(SettledState& s, const Config& config, const TrialCriteria& crit,
+                           bool quiet) {
+  const auto t0 = Clock::now();
+  Simulation& sim = s.sim;
+  const MotionExtent allowed = support_allowance(sim.supports, s.l_ref);
+  const double ramp = config.supports.ramp;
+  start_supports(config, sim);
+  if (allowed.displacement == 0.0 && allowed.rotation == 0.0) return;
+  const Outcome o = run_support_movement(sim, s.gravity, s.l_ref, ramp, allowed, crit, quiet);
+  s.settled = o.decided && !o.collapsed;
+  s.collapsed = o.decided && o.collapsed;
+  s.supports_collapsed = s.collapsed;
+  s.supports_time = o.time;
+  s.max_displacement = o.motion.displacement;
+  s.max_rotation = o.motion.rotation;
+  set_static_load(sim, s.gravity, 0.0);
+  s.settle_time = sim.ctx.time;
+  s.steps = sim.step;
+  s.wall_s += seconds_since(t0);
+  if (!quiet)
+    std::fprintf(stderr,
+                 "supports moved (%zu, over %.3g s): %s after %.3f s (%lld steps in all, %.2f s "
+                 "wall; energy balance error %.2g)\n",
+                 sim.supports.moves.size(), ramp,
+                 s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"), o.time,
+                 s.steps, s.wall_s, sim.ledger.balance_error());
 }
 
 Model mirror_x(const Model& model) {
@@ -111,9 +195,57 @@ Model mirror_x(const Model& model) {
   return m;
 }
 
+MovedBlocks moved_blocks(const Simulation& sim, bool mirror) {
+  Model reference = sim.model;
+  sync_rigid_nodes(reference);
+  const std::vector<BlockMotion> motion = block_motions(reference);
+  MovedBlocks out;
+  out.model = reference;
+  for (std::size_t b = 0; b < motion.size(); ++b)
+    for (Vec2& p : out.model.blocks[b].polygon) p = move_point(motion[b], p);
+  auto carried = [&](Index a, Index b, Vec2 p) {
+    return 0.5 * (move_point(motion[std::size_t(a)], p) + move_point(motion[std::size_t(b)], p));
+  };
+  for (Joint& j : out.model.joints) {
+    j.a = carried(j.block_a, j.block_b, j.a);
+    j.b = carried(j.block_a, j.block_b, j.b);
+  }
+  for (Interface f : find_interfaces(sim.model)) {
+    const double turn =
+        0.5 * (motion[std::size_t(f.block_a)].rotation + motion[std::size_t(f.block_b)].rotation);
+    const double c = std::cos(turn), s = std::sin(turn);
+    f.a = carried(f.block_a, f.block_b, f.a);
+    f.b = carried(f.block_a, f.block_b, f.b);
+    f.normal = {c * f.normal.x - s * f.normal.y, s * f.normal.x + c * f.normal.y};
+    out.interfaces.push_back(f);
+  }
+  if (mirror) {
+    out.model = mirror_x(out.model);
+    for (Interface& f : out.interfaces) f.a.x = -f.a.x, f.b.x = -f.b.x, f.normal.x = -f.normal.x;
+  }
+  return out;
+}
+
+LimitResult limit_of_settled(const SettledState& settled, double friction, double direction) {
+  const Simulation& sim = settled.sim;
+  if (sim.supports.empty())
+    return limit_analysis(direction < 0.0 ? mirror_x(sim.model) : sim.model, friction,
+                          settled.gravity, false);
+  const MovedBlocks moved = moved_blocks(sim, direction < 0.0);
+  LimitOptions options;
+  options.interfaces = &moved.interfaces;
+  return limit_analysis(moved.model, friction, settled.gravity, false, options);
+}
+
 std::string unsettled_message(const SettledState& s, const TrialCriteria& crit) {
   char buf[320];
-  if (s.collapsed)
+  if (s.supports_collapsed)
+    std::snprintf(buf, sizeof buf,
+                  "the structure collapses while its supports move ([supports]): a block moved "
+                  "%.3g m and rotated %.3g rad within %.3g s of the movement's start (no "
+                  "capacity left, lambda* = 0)",
+                  s.max_displacement, s.max_rotation, s.supports_time);
+  else if (s.collapsed)
     std::snprintf(buf, sizeof buf,
                   "the structure collapses under gravity alone: a block moved %.3g m and "
                   "rotated %.3g rad within %.3g s of settling (no gravity capacity, "
@@ -430,9 +562,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     if (!have_hi) lo = hi;
   } else if (search.seed_from_limit) {
     // Towards -x: limit analysis of the mirror image towards +x.
-    const LimitResult la = limit_analysis(
-        crit.direction < 0.0 ? mirror_x(settled.sim.model) : settled.sim.model,
-        config.contact.friction, settled.gravity, false);
+    const LimitResult la = limit_of_settled(settled, config.contact.friction, crit.direction);
     res.seed.status = la.status;
     if (la.status == "optimal" && la.lambda_la > lo) {
       res.seed.used = true;

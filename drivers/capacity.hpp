@@ -53,6 +53,7 @@
 #include "drivers/kinematics.hpp"
 #include "drivers/thrust.hpp"
 #include "drivers/trial.hpp"
+#include "limit/limit_analysis.hpp"
 
 namespace voussoir {
 
@@ -114,17 +115,67 @@ struct SettledState {
   bool collapsed = false;              // a block passed the collapse criterion while settling
   double max_displacement = 0.0;       // [m] largest block motion while settling
   double max_rotation = 0.0;           // [rad]
+  // [supports]: the movement's run time [s] (settle_time includes it), and whether the
+  // structure collapsed while the supports moved (then `collapsed` too)
+  double supports_time = 0.0;
+  bool supports_collapsed = false;
 };
 
 // Settles the model of `config` under gravity (lambda = 0): until rest (the trial criteria's
 // rest rule), a collapse (their displacement or rotation rule: no gravity capacity), or
-// `settle_max_time`.
+// `settle_max_time`. With [supports] moves, once at rest the supports move over
+// supports.ramp and the structure is held until rest again (move_supports_settled): every
+// analysis that starts from this state (capacity, sweep, pulse) runs on the moved structure.
 SettledState settle(const Config& config, const TrialCriteria& criteria, bool quiet);
+
+// What a support movement may move the free blocks by without a collapse: the moved blocks
+// carry the structure with them, so the collapse limits of the phases in which supports move
+// add the largest support displacement |d| times 3 (a three-hinge mechanism turns the
+// movement of a support into a larger one of the crown) to the displacement limit [m], and
+// 3 |d| / L_ref plus the largest prescribed rotation to the rotation limit [rad].
+MotionExtent support_allowance(const SupportMotion& supports, double l_ref);
+
+// A support movement already started on `sim` (core/supports.hpp start_support_motion or
+// retarget_support_motion at sim.ctx.time) under gravity: the ramp over `ramp` seconds, with
+// the quasi-static local and kinetic damping off (they act on absolute velocities and would
+// hold back the blocks the supports carry: the blocks slid on their moving supports) and the
+// collapse limits widened by `allowed` (support_allowance); then, the damping back on, held
+// until rest (the settle's rest rule) or the settle's time limit, collapse limits as settled
+// and motion measured from the end of the ramp. Outcome: decided and not collapsed = at rest.
+Outcome run_support_movement(Simulation& sim, double gravity, double l_ref, double ramp,
+                             const MotionExtent& allowed, const TrialCriteria& criteria,
+                             bool quiet);
+
+// The support movement of `settle` on a settled state (run_support_movement).
+void move_supports_settled(SettledState& settled, const Config& config,
+                           const TrialCriteria& criteria, bool quiet);
 
 // The block outlines and joints of `model` mirrored about x = 0 (outlines counter-clockwise):
 // what limit analysis reads, so that its lambda towards +x is the original's towards -x.
 // Nodes and triangles are copied unchanged.
 Model mirror_x(const Model& model);
+
+// The blocks of a simulation where they are, for limit analysis of a structure whose supports
+// moved: every outline (and joint) carried by its block's rigid motion (drivers/kinematics.hpp
+// block_motions), and the interfaces of the reference outlines, each end carried by the mean
+// of its two blocks' motions and its normal turned by their mean rotation (an open hinge's
+// faces no longer meet face to face, so find_interfaces would not find them; the joint gaps
+// are a small fraction of the joint length), so the LP takes every joint as closed. Tried and
+// rejected: an open hinge (find_hinges, kHingeFraction L_ref) kept as a point contact at its
+// pivot. A symmetric spread opens both joints of the crown block, and the LP then sees a
+// four-hinge chain: lambda_la = 1e-6 on the semicircular arch spread by 0.5% to 2% of its
+// span, where the FDEM arch carries 0.26 to 0.29 (docs/supports.md). `mirror`: mirrored about
+// x = 0 (mirror_x), for the load towards -x.
+struct MovedBlocks {
+  Model model;
+  std::vector<Interface> interfaces;
+};
+MovedBlocks moved_blocks(const Simulation& sim, bool mirror = false);
+
+// Limit analysis (lambda_la towards +x, or towards -x when direction < 0) of the blocks of a
+// settled state: of the reference outlines when no support moved (bit for bit the plain
+// limit_analysis), else of moved_blocks.
+LimitResult limit_of_settled(const SettledState& settled, double friction, double direction);
 
 // Why a settle did not end at rest, for the error of the commands that need rest.
 std::string unsettled_message(const SettledState& settled, const TrialCriteria& criteria);

@@ -32,6 +32,7 @@ nlohmann::json model_geometry_json(const Model& model) {
     json poly = json::array();
     for (const Vec2& p : b.polygon) poly.push_back({p.x, p.y});
     blocks.push_back({{"fixed", b.fixed}, {"role", b.role}, {"name", b.name}, {"polygon", poly}});
+    if (b.prescribed) blocks.back()["moves"] = true;  // a support that [supports] moves
   }
   json joints = json::array();
   for (const Joint& j : model.joints)
@@ -89,6 +90,21 @@ int command_check(const Config& config, const CommonOptions& common, const Check
     for (std::size_t b = 0; b < m.blocks.size(); ++b)
       std::printf("  block %-4zu %-5s \"%s\"\n", b, m.blocks[b].fixed ? "fixed" : "free",
                   m.blocks[b].name.c_str());
+  // Which block number is which support (the numbers [supports] moves take), and the moves.
+  std::printf("supports   ");
+  for (std::size_t b = 0; b < m.blocks.size(); ++b)
+    if (m.blocks[b].fixed) {
+      Vec2 c{};
+      for (const Vec2& p : m.blocks[b].polygon) c = c + (1.0 / m.blocks[b].polygon.size()) * p;
+      std::printf(" %zu (%s at %.3g, %.3g)", b, m.blocks[b].role.c_str(), c.x, c.y);
+    }
+  std::printf("\n");
+  for (const SupportMove& mv : sim.supports.moves)
+    std::printf(
+        "  move block %d (%s): dx = %.6g m, dy = %.6g m, rotation = %.6g deg, over %.4g s "
+        "after the settle\n",
+        mv.block, m.blocks[std::size_t(mv.block)].role.c_str(), mv.dx, mv.dy,
+        mv.rotation * 180.0 / M_PI, config.supports.ramp);
   std::printf("triangles   %d\n", m.tris.size());
   std::printf("nodes       %d\n", m.nodes.size());
   std::printf("free area   %.6g m2\n", free_area(m));
@@ -156,6 +172,13 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                          {"min_block", fastest},
                          {"median", body_steps[body_steps.size() / 2]},
                          {"max", body_steps.back()}};
+    nlohmann::json moves = nlohmann::json::array();
+    for (const SupportMove& mv : sim.supports.moves)
+      moves.push_back({{"block", mv.block},
+                       {"dx", mv.dx},
+                       {"dy", mv.dy},
+                       {"rotation", mv.rotation * 180.0 / M_PI}});
+    j["supports"] = {{"moves", moves}, {"ramp", config.supports.ramp}};
     if (named) {
       nlohmann::json names = nlohmann::json::array();
       for (const Block& b : m.blocks) names.push_back(b.name);

@@ -1,7 +1,10 @@
 // `voussoir limit DECK`: rigid-block limit analysis on the blocks of the deck's model — the
 // collapse load factor lambda_la and its mechanism, or (--gravity-only) whether an admissible
-// equilibrium exists under self-weight alone. Friction: contact.friction (associative, so an
-// upper bound where sliding governs); gravity: load.gravity.
+// equilibrium exists under self-weight alone, or (--thrust min|max) the least or greatest
+// horizontal thrust on the supports under self-weight ("thrust_min" / "thrust_max" in N per
+// model.out_of_plane; --mechanism-out then carries that equilibrium's line of thrust, the
+// centres of pressure of the interfaces, for scripts/draw). Friction: contact.friction
+// (associative, so an upper bound where sliding governs); gravity: load.gravity.
 
 #include <chrono>
 #include <cmath>
@@ -9,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "drivers/capacity.hpp"
 #include "drivers/limit_command.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
@@ -42,6 +46,27 @@ nlohmann::json mechanism_json(const LimitResult& res) {
   return out;
 }
 
+// The line of thrust of the LP's equilibrium in the form of the joint resultants
+// (drivers/thrust.hpp) that scripts/draw reads: per interface with a compressive resultant, its
+// blocks, normal force and centre of pressure (the end forces' normal components weighted).
+nlohmann::json thrust_line_json(const LimitResult& res) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t k = 0; k < res.interfaces.size() && k < res.forces.size(); ++k) {
+    const Interface& f = res.interfaces[k];
+    const InterfaceForces& F = res.forces[k];
+    const double n = F.normal_a + F.normal_b;
+    nlohmann::json j = {
+        {"joint", f.joint}, {"blocks", {f.block_a, f.block_b}}, {"normal_force", n}};
+    if (n > 0.0)
+      j["point"] = {(F.normal_a * f.a.x + F.normal_b * f.b.x) / n,
+                    (F.normal_a * f.a.y + F.normal_b * f.b.y) / n};
+    else
+      j["point"] = nullptr;
+    out.push_back(j);
+  }
+  return out;
+}
+
 nlohmann::json interfaces_json(const LimitResult& res) {
   nlohmann::json out = nlohmann::json::array();
   for (std::size_t k = 0; k < res.interfaces.size(); ++k) {
@@ -69,7 +94,20 @@ nlohmann::json interfaces_json(const LimitResult& res) {
 int command_limit(const Config& config, const CommonOptions& common,
                   const LimitCommandOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Model model = build_model(scene_params(config));
+  // [supports]: the blocks where the support movement leaves them (settled under gravity and
+  // moved as `capacity` does it, then carried rigidly: drivers/capacity.hpp moved_blocks).
+  MovedBlocks moved;
+  LimitOptions options;
+  if (!config.supports.moves.empty()) {
+    TrialCriteria crit;
+    crit.quasi_static = true;
+    const SettledState settled = settle(config, crit, common.quiet);
+    if (!settled.settled)
+      throw RunError(config.deck_path + ": " + unsettled_message(settled, crit));
+    moved = moved_blocks(settled.sim);
+    options.interfaces = &moved.interfaces;
+  }
+  const Model model = options.interfaces ? moved.model : build_model(scene_params(config));
   const double model_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double mu = config.contact.friction;
@@ -83,7 +121,12 @@ int command_limit(const Config& config, const CommonOptions& common,
   if (!common.quiet)
     std::fprintf(stderr, "limit: %zu blocks, model built in %.2f s; solving the LP...\n",
                  model.blocks.size(), model_s);
-  const LimitResult res = limit_analysis(model, mu, g, opts.gravity_only);
+  const bool thrust = !opts.thrust.empty();
+  const std::string thrust_key = "thrust_" + opts.thrust;
+  const LimitResult res =
+      thrust ? limit_thrust(model, mu, g,
+                            opts.thrust == "min" ? ThrustBound::Min : ThrustBound::Max, options)
+             : limit_analysis(model, mu, g, opts.gravity_only, options);
 
   std::printf("deck        %s\n", config.deck_path.c_str());
   std::printf("model       %s: %d free blocks, %zu interfaces (mu = %.4g)\n", model.kind.c_str(),
@@ -91,7 +134,17 @@ int command_limit(const Config& config, const CommonOptions& common,
   std::printf("LP          %d rows x %d columns, %d iterations, %s, %.3f s\n", res.rows,
               res.columns, res.iterations, res.exact ? "exact check passed" : "no exact check",
               res.wall_s);
-  if (opts.gravity_only) {
+  if (thrust) {
+    if (res.status == "optimal")
+      std::printf("%-11s %.6g N (per out_of_plane %.4g m; outward on each side, lambda = 0)\n",
+                  thrust_key.c_str(), res.thrust, model.out_of_plane);
+    else if (res.status == "unbounded")
+      std::printf("%-11s unbounded: the supports can take any thrust (a flat arch)\n",
+                  thrust_key.c_str());
+    else
+      std::printf("%-11s none: %s (no admissible equilibrium under self-weight)\n",
+                  thrust_key.c_str(), res.status.c_str());
+  } else if (opts.gravity_only) {
     std::printf("gravity     %s: %s\n", res.admissible ? "admissible" : "NOT admissible",
                 res.admissible ? "an equilibrium with N >= 0 and |S| <= mu N exists"
                                : "no equilibrium under self-weight with N >= 0, |S| <= mu N");
@@ -137,7 +190,10 @@ int command_limit(const Config& config, const CommonOptions& common,
                         {"lp_wall_s", res.wall_s},
                         {"model_wall_s", model_s},
                         {"wall_s", wall_s}};
-    if (!opts.gravity_only) {
+    if (thrust) {
+      j[thrust_key] = number_or_null(res.thrust);
+      j["out_of_plane"] = model.out_of_plane;
+    } else if (!opts.gravity_only) {
       j["lambda_la"] = number_or_null(res.lambda_la);
       j["mechanism"] = mechanism_json(res);
     }
@@ -154,6 +210,13 @@ int command_limit(const Config& config, const CommonOptions& common,
                     {"mechanism", mechanism_json(res)},
                     {"interfaces", interfaces_json(res)},
                     {"block_velocities", vel}};
+    if (thrust) {
+      geo["limit"][thrust_key] = number_or_null(res.thrust);
+      char label[96];
+      std::snprintf(label, sizeof label, "%s = %.4g N", thrust_key.c_str(), res.thrust);
+      geo["thrust"] =
+          nlohmann::json::array({{{"label", label}, {"joints", thrust_line_json(res)}}});
+    }
     write_json(geo, opts.mechanism_out);
   }
   return 0;

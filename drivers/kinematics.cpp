@@ -80,11 +80,20 @@ std::vector<Hinge> find_hinges(const Model& model, double open_tol, double slip_
   // Joints of one mechanism open at different rates (the springing hinge of an arch opens
   // less than the crown one): a joint counts when its gap reaches `open_tol` or a quarter of
   // the largest gap of the model, whichever is smaller, but never below open_tol / 10.
+  // A joint between two fixed blocks is no hinge: it moves only as [supports] prescribe (a
+  // settled pier sinks into its ground), and carries no contact.
+  auto between_supports = [&model](const JointState& s) {
+    const Joint& jt = model.joints[std::size_t(s.joint)];
+    return model.blocks[std::size_t(jt.block_a)].fixed &&
+           model.blocks[std::size_t(jt.block_b)].fixed;
+  };
   double largest = 0.0;
-  for (const JointState& s : states) largest = std::max({largest, s.opening_a, s.opening_b});
+  for (const JointState& s : states)
+    if (!between_supports(s)) largest = std::max({largest, s.opening_a, s.opening_b});
   open_tol = std::max(0.1 * open_tol, std::min(open_tol, 0.25 * largest));
   std::vector<Hinge> out;
   for (const JointState& s : states) {
+    if (between_supports(s)) continue;
     const Joint& jt = model.joints[s.joint];
     const double opening = std::max(s.opening_a, s.opening_b);
     Hinge h;

@@ -49,7 +49,8 @@ struct Hinge {
 // Joints whose largest gap exceeds `open_tol` (lowered to a quarter of the largest gap of the
 // model when that is smaller, but not below open_tol / 10) become hinges (pivot at the closed end, or at the
 // less-open end if both opened); joints whose slip exceeds `slip_tol` and that did not open
-// become sliding joints. Sorted by joint index.
+// become sliding joints. Joints between two fixed blocks are never reported. Sorted by joint
+// index.
 std::vector<Hinge> find_hinges(const Model& model, double open_tol, double slip_tol);
 
 }  // namespace voussoir

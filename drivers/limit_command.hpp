@@ -11,6 +11,7 @@ namespace voussoir {
 struct LimitCommandOptions {
   bool gravity_only = false;  // --gravity-only: admissibility under self-weight alone
   std::string mechanism_out;  // --mechanism-out FILE: geometry + mechanism JSON (scripts/draw)
+  std::string thrust;         // --thrust min|max: the least / greatest support thrust ("": off)
 };
 
 int command_limit(const Config& config, const CommonOptions& common,

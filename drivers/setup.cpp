@@ -6,6 +6,7 @@
 #include "contact/joint_stiffness.hpp"
 #include "core/cst.hpp"
 #include "core/rigid.hpp"
+#include "core/supports.hpp"
 #include "io/deck.hpp"
 #include "mesh/minimal.hpp"
 #include "mesh/scene.hpp"
@@ -25,6 +26,35 @@ void set_static_load(Simulation& sim, double gravity, double lambda) {
   sim.ctx.body_ay = -gravity;
 }
 
+void prescribe_supports(const Config& config, Simulation& sim) {
+  const std::vector<Block>& blocks = sim.model.blocks;
+  std::vector<SupportMove> moves;
+  for (std::size_t k = 0; k < config.supports.moves.size(); ++k) {
+    const SupportMoveConfig& m = config.supports.moves[k];
+    const bool exists = m.block >= 0 && std::size_t(m.block) < blocks.size();
+    if (!exists || !blocks[std::size_t(m.block)].fixed) {
+      std::ostringstream msg;
+      msg << config.deck_path << ": supports.moves[" << k << "].block = " << m.block
+          << ": expected a fixed block (";
+      if (!exists)
+        msg << "the model has blocks 0 to " << blocks.size() - 1;
+      else
+        msg << "block " << m.block << " is a free " << blocks[std::size_t(m.block)].role;
+      msg << "; the fixed ones:";
+      for (std::size_t b = 0; b < blocks.size(); ++b)
+        if (blocks[b].fixed) msg << " " << b << " (" << blocks[b].role << ")";
+      msg << ")";
+      throw DeckError(msg.str());
+    }
+    moves.push_back({m.block, m.dx, m.dy, m.rotation * M_PI / 180.0});
+  }
+  prescribe_supports(sim.model, moves, sim.supports);
+}
+
+void start_supports(const Config& config, Simulation& sim) {
+  if (!sim.supports.empty()) start_support_motion(sim.supports, sim.ctx.time, config.supports.ramp);
+}
+
 Simulation make_simulation(const Config& config, SetupInfo* info) {
   Simulation sim;
   sim.model = build_model(scene_params(config));
@@ -34,6 +64,7 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
     sim.model = minimal_model(sim.model, config.mesh.chord_tolerance);
     make_blocks_rigid(sim.model);
   }
+  prescribe_supports(config, sim);
   ContactParams cp;
   cp.penalty = contact_penalty(config);
   cp.friction = config.contact.friction;

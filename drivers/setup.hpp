@@ -30,6 +30,15 @@ double contact_penalty(const Config& config);
 // Builds the simulation. A user dt above the stable limit throws DeckError naming the limit.
 Simulation make_simulation(const Config& config, SetupInfo* info = nullptr);
 
+// The deck's [supports] moves marked on sim.model and recorded in sim.supports (core/
+// supports.hpp; make_simulation calls it before the contact set-up). A move of a free or
+// unknown block throws DeckError naming supports.moves[k].block and its value.
+void prescribe_supports(const Config& config, Simulation& sim);
+
+// Starts the deck's support movement at the simulation's current time, over supports.ramp:
+// the drivers call it once the structure has settled under gravity. Nothing without moves.
+void start_supports(const Config& config, Simulation& sim);
+
 // Sets the body load of the context: gravity down, lambda g horizontal.
 void set_static_load(Simulation& sim, double gravity, double lambda);
 

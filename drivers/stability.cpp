@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/scene_kinds.hpp"
+#include "drivers/capacity.hpp"
 #include "drivers/dealer.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
@@ -66,7 +67,17 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   const double d_collapse = tc.collapse_displacement * c.l_ref;
 
   // Gravity ramped on from rest; motions measured from the unloaded geometry. A decided cell
-  // runs on to ke_time, when its kinetic energy is read.
+  // runs on to ke_time, when its kinetic energy is read. [supports]: the supports move once
+  // the gravity ramp is on, over supports.ramp; rest is judged and the kinetic energy read
+  // that much later, and the collapse limits widen by what the movement imposes.
+  double moved_by = 0.0;  // [s] the support movement's share of the cell's time
+  MotionExtent allowed;
+  if (!sim.supports.empty()) {
+    start_support_motion(sim.supports, tc.ramp_time, config.supports.ramp);
+    moved_by = config.supports.ramp;
+    allowed = support_allowance(sim.supports, c.l_ref);
+  }
+  const double ke_time = crit.ke_time + moved_by;
   RunSpec spec;
   spec.label = "the stability cell " + cell_label;
   spec.loads = LoadProgram{};
@@ -74,14 +85,16 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   spec.loads->gravity_ramp = tc.ramp_time;
   spec.limits = tc.limits;
   spec.track_motion = true;
-  spec.min_time = crit.ke_time;
-  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, tc.collapse_rotation));
-  spec.rules.push_back(std::make_unique<RestRule>(v_rest, tc.hold_time, tc.ramp_time));
-  spec.rules.push_back(
-      std::make_unique<TrendRule>(d_collapse, tc.collapse_rotation, 0.0, tc.ramp_time, tc.max_time));
+  spec.min_time = ke_time;
+  spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse + allowed.displacement,
+                                                      tc.collapse_rotation + allowed.rotation));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, tc.hold_time, tc.ramp_time + moved_by));
+  spec.rules.push_back(std::make_unique<TrendRule>(
+      d_collapse, tc.collapse_rotation, moved_by > 0.0 ? tc.ramp_time + moved_by : 0.0,
+      tc.ramp_time + moved_by, tc.max_time + moved_by));
   bool ke_read = false;
   spec.on_sample = [&](const Simulation& s, const Probe& p) {
-    if (!ke_read && p.time >= crit.ke_time) {
+    if (!ke_read && p.time >= ke_time) {
       c.kinetic_energy = s.ledger.kinetic;
       c.ke_read_time = p.time;
       ke_read = true;

@@ -6,6 +6,8 @@
 #include <map>
 #include <utility>
 
+#include "limit/interfaces.hpp"
+
 namespace voussoir {
 
 namespace {
@@ -166,6 +168,36 @@ void write_snapshot_thrust(RunWriter& writer, const Model& model, const ContactS
                            double dt, double lambda) {
   writer.write_snapshot_joints(snapshot_joints(joint_resultants(model, contact, dt)));
   writer.write_snapshot_attribute("lambda", lambda);
+}
+
+double free_weight_x(const Model& model) {
+  double a = 0.0, ax = 0.0;
+  for (const Block& b : model.blocks) {
+    if (b.fixed) continue;
+    Vec2 c;
+    const double area = polygon_centroid(b.polygon, &c);
+    a += area;
+    ax += area * c.x;
+  }
+  return a > 0.0 ? ax / a : 0.0;
+}
+
+SupportThrust support_thrust(const Model& model, const std::vector<JointResultant>& joints) {
+  const double xg = free_weight_x(model);
+  SupportThrust h;
+  for (const JointResultant& j : joints) {
+    const bool fixed_a = model.blocks[std::size_t(j.block_a)].fixed;
+    const bool fixed_b = model.blocks[std::size_t(j.block_b)].fixed;
+    if (fixed_a == fixed_b || !j.closed) continue;
+    // j.force acts on block_b: the fixed block takes +force as b, -force as a.
+    const double on_fixed = fixed_b ? j.force.x : -j.force.x;
+    const Joint& joint = model.joints[std::size_t(j.joint)];
+    if (0.5 * (joint.a.x + joint.b.x) < xg)
+      h.left -= on_fixed;
+    else
+      h.right += on_fixed;
+  }
+  return h;
 }
 
 }  // namespace voussoir

@@ -399,6 +399,51 @@ const std::vector<KeySpec>& key_table() {
       {"capacity.kinetic_damping", [](Reader& r, const toml::node& n, Config& c) { c.capacity.kinetic_damping = r.number(n, {0, false, 1, true}, "fraction of the peak kinetic energy"); }},
       {"capacity.mass_scaling", [](Reader& r, const toml::node& n, Config& c) { c.capacity.mass_scaling = r.choice(n, {"equalize", "none"}); }},
       {"capacity.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.capacity.tolerance = r.number(n, {0, true, 1, true}, "relative bracket width"); }},
+      // [supports]
+      {"supports.moves", [](Reader& r, const toml::node& n, Config& c) {
+         const char* what =
+             "an array of {block = B, dx = X, dy = Y, rotation = R} (B: a fixed block's index, "
+             "X, Y in m, R in degrees, |R| <= 90; dx, dy, rotation optional, 0 by default), each block once";
+         const toml::array& a = r.array(n, what);
+         c.supports.moves.clear();
+         for (std::size_t k = 0; k < a.size(); ++k) {
+           const toml::node& e = *a.get(k);
+           const auto* t = e.as_table();
+           if (t == nullptr) r.fail(n, what);
+           const std::string entry = "supports.moves[" + std::to_string(k) + "].";
+           auto bad = [&](const std::string& field, const toml::node& v, const std::string& allowed) {
+             throw DeckError(one_line(r.where(r.key, &v) + entry + field + " = " + value_text(v) +
+                                      ": expected " + allowed));
+           };
+           SupportMoveConfig m;
+           if (!t->contains("block")) r.fail(n, what);
+           for (auto&& [name, v] : *t) {
+             const std::string field(name.str());
+             if (field == "block") {
+               const auto* i = v.as_integer();
+               if (i == nullptr || i->get() < 0 || i->get() > std::numeric_limits<int>::max())
+                 bad(field, v, "a block index (an integer >= 0)");
+               m.block = static_cast<int>(i->get());
+               for (const SupportMoveConfig& o : c.supports.moves)
+                 if (o.block == m.block) bad(field, v, "each block at most once");
+               continue;
+             }
+             double* out = field == "dx" ? &m.dx : field == "dy" ? &m.dy
+                                        : field == "rotation" ? &m.rotation : nullptr;
+             if (out == nullptr) bad(field, v, "one of the fields block, dx, dy, rotation");
+             const auto* i = v.as_integer();
+             const auto* f = v.as_floating_point();
+             const double x = i ? static_cast<double>(i->get()) : f ? f->get() : NAN;
+             const bool angle = field == "rotation";
+             if (!std::isfinite(x) || (angle && !(std::abs(x) <= 90.0)))
+               bad(field, v, angle ? "a finite number of degrees in [-90, 90]"
+                                   : "a finite number [m]");
+             *out = x;
+           }
+           c.supports.moves.push_back(m);
+         }
+       }},
+      {"supports.ramp", [](Reader& r, const toml::node& n, Config& c) { c.supports.ramp = r.number(n, above(0), "s"); }},
       // [output]
       {"output.file", [](Reader& r, const toml::node& n, Config& c) { c.output.file = r.string(n); }},
       {"output.every", [](Reader& r, const toml::node& n, Config& c) { c.output.every = r.number(n, above(0), "s"); }},

@@ -53,8 +53,9 @@ const std::map<std::string, std::string>& meanings() {
        "narrower (refused naming the file's line, the block and the vertex; format: "
        "mesh/scenes_polygons.cpp)"},
       {"model.fixed",
-       "polygons: indices of the fixed blocks (file order; gmsh: physical tag order); at least "
-       "one block must stay free"},
+       "polygons: indices of the fixed blocks (file order; gmsh: physical tag order); other "
+       "kinds: blocks fixed besides the scene's supports (a pier to settle with [supports]); "
+       "at least one block must stay free"},
       {"model.out_of_plane", "out-of-plane thickness: masses and forces scale with it"},
       // [mesh]
       {"mesh.chord_tolerance",
@@ -120,6 +121,15 @@ const std::map<std::string, std::string>& meanings() {
        "rigid blocks in the same phases: equalize lowers the mass and inertia of each block "
        "until its own stable step is the model's (loads keep the true masses); none: true "
        "inertia (`--dynamic`: none; docs/capacity.md)"},
+      // [supports]
+      {"supports.moves",
+       "prescribed movements of fixed blocks: block (its number in `check`, which lists the "
+       "supports), dx, dy [m] and rotation [deg, counter-clockwise about its centroid]; every "
+       "command settles under gravity, moves them over `ramp`, then runs on the moved "
+       "structure (`run`: from t = 0; docs/supports.md)"},
+      {"supports.ramp",
+       "time over which the moves are reached, by a ramp with zero velocity and acceleration "
+       "at both ends (docs/supports.md)"},
       // [output]
       {"output.file", "HDF5 file of `run` / `pulse` (XDMF beside it); empty: none"},
       {"output.every", "snapshot interval"},
@@ -210,6 +220,8 @@ std::string default_of(const std::string& key) {
       {"capacity.local_damping_mode", quoted(c.capacity.local_damping_mode)},
       {"capacity.kinetic_damping", number(c.capacity.kinetic_damping)},
       {"capacity.mass_scaling", quoted(c.capacity.mass_scaling)},
+      {"supports.moves", "[] (none)"},
+      {"supports.ramp", number(c.supports.ramp)},
       {"output.file", "none"},
       {"output.every", number(c.output.every)},
       {"output.fields", list(c.output.fields, quoted)},

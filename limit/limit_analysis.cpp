@@ -15,9 +15,9 @@
 //   sum F_y                       = W_i
 //   sum (r x F) - lambda W_i r_cy = W_i r_cx,        r = p - O, r_c = c_i - O.
 // Fixed blocks have no equations. Objective: maximise lambda (gravity_only: lambda fixed at 0,
-// a feasibility problem). Scaling: lengths in units of the free blocks' bounding-box diagonal
-// L about its centre O, forces in units of the mean free-block weight, so the coefficients are
-// O(1) for any model size; lambda does not depend on either choice (or on g, rho).
+// a feasibility problem; thrust: below). Scaling: lengths in units of the free blocks' bounding-box
+// diagonal L about its centre O, forces in units of the mean free-block weight, so the coefficients
+// are O(1) for any model size; lambda does not depend on either choice (or on g, rho).
 //
 // The dual is the virtual-work (kinematic) problem: the row multipliers of block i are its
 // virtual velocity (u_x, u_y, omega) (velocity of the point r: u + omega e_z x r), the dual
@@ -32,6 +32,18 @@
 // whose relative velocity has a normal component opens; an interface whose ends have relative
 // velocity is in the mechanism: sliding if its tangential rate is non-zero, else a hinge at
 // the end that stays in contact (the smaller opening), "separation" if both ends open.
+//
+// Thrust (limit_thrust). With lambda fixed at 0 the free blocks' loads have no horizontal
+// component, so the horizontal forces on all the fixed blocks sum to zero: what the structure
+// pushes outward on its supports on the left equals what it pushes outward on the right. Let
+// x_G be the abscissa of the free blocks' centre of weight and L the interfaces between a free
+// and a fixed block whose middle lies left of x_G. The thrust is
+//   H = - sum over L of (horizontal force on the fixed block)
+//     = sum over the edge columns f of L:  -d_x f  (fixed block b)  or  +d_x f  (fixed block a),
+// linear in the columns, so min H and max H are LPs over the same feasible set (Heyman's least
+// and greatest thrust: the arch on supports that spread, or that are pushed together). The
+// dual of the min thrust LP is the mechanism that a unit spreading of the supports drives.
+// A flat arch (a lintel of voussoirs) has no greatest thrust: the LP is unbounded.
 //
 // Solver: glp_simplex (dual then primal phases, presolve off so that duals and an infeasible
 // status are always available), then glp_exact from the final basis: the rational re-solve
@@ -71,6 +83,12 @@ struct EdgeColumn {
   double sign;  // +1: n + mu t, -1: n - mu t
 };
 
+// What the LP optimises: lambda, nothing (admissibility), or the support thrust.
+enum class Objective { Lambda, Admissible, ThrustMin, ThrustMax };
+
+LimitResult solve_limit_lp(const Model& model, double mu, double gravity, Objective objective,
+                           const LimitOptions& options);
+
 }  // namespace
 
 LimitResult limit_analysis(const Model& model, double mu, double gravity, bool gravity_only) {
@@ -79,6 +97,23 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
 
 LimitResult limit_analysis(const Model& model, double mu, double gravity, bool gravity_only,
                            const LimitOptions& options) {
+  return solve_limit_lp(model, mu, gravity,
+                        gravity_only ? Objective::Admissible : Objective::Lambda, options);
+}
+
+LimitResult limit_thrust(const Model& model, double mu, double gravity, ThrustBound bound,
+                         const LimitOptions& options) {
+  return solve_limit_lp(model, mu, gravity,
+                        bound == ThrustBound::Min ? Objective::ThrustMin : Objective::ThrustMax,
+                        options);
+}
+
+namespace {
+
+LimitResult solve_limit_lp(const Model& model, double mu, double gravity, Objective objective,
+                           const LimitOptions& options) {
+  const bool gravity_only = objective != Objective::Lambda;
+  const bool thrust = objective == Objective::ThrustMin || objective == Objective::ThrustMax;
   if (!(mu >= 0.0) || !std::isfinite(mu))
     throw std::invalid_argument("limit_analysis: friction must be finite and >= 0");
   if (!(gravity > 0.0) || !std::isfinite(gravity))
@@ -88,6 +123,7 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
   LimitResult res;
   res.gravity_only = gravity_only;
   res.lambda_la = kNaN;
+  res.thrust = kNaN;
 
   // Blocks: area and centroid of the outline; row index of each free block.
   const std::size_t nb = model.blocks.size();
@@ -95,12 +131,14 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
   std::vector<Vec2> centroid(nb);
   std::vector<int> first_row(nb, -1);  // 1-based GLPK row of the block's x equation
   double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, free_area_sum = 0.0;
+  double free_moment_x = 0.0;  // sum of A x_c over the free blocks, for x_G
   for (std::size_t i = 0; i < nb; ++i) {
     const Block& b = model.blocks[i];
     area[i] = polygon_centroid(b.polygon, &centroid[i]);
     if (b.fixed) continue;
     first_row[i] = 1 + 3 * res.free_blocks++;
     free_area_sum += area[i];
+    free_moment_x += area[i] * centroid[i].x;
     for (const Vec2& p : b.polygon) {
       x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
       y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
@@ -115,7 +153,9 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
   auto scaled = [&](Vec2 p) { return Vec2{(p.x - origin.x) / length, (p.y - origin.y) / length}; };
 
   // Interfaces that touch a free block.
-  for (const Interface& f : find_interfaces(model, options.interface_tol))
+  const std::vector<Interface> found =
+      options.interfaces ? std::vector<Interface>{} : find_interfaces(model, options.interface_tol);
+  for (const Interface& f : options.interfaces ? *options.interfaces : found)
     if (!model.blocks[f.block_a].fixed || !model.blocks[f.block_b].fixed)
       res.interfaces.push_back(f);
   const Index ni = static_cast<Index>(res.interfaces.size());
@@ -133,7 +173,7 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
 
   std::unique_ptr<glp_prob, GlpDeleter> lp(glp_create_prob());
   glp_prob* P = lp.get();
-  glp_set_obj_dir(P, GLP_MAX);
+  glp_set_obj_dir(P, objective == Objective::ThrustMin ? GLP_MIN : GLP_MAX);
   glp_add_rows(P, res.rows);
   glp_add_cols(P, res.columns);
   std::vector<int> ia{0}, ja{0};
@@ -162,7 +202,8 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
     glp_set_col_bnds(P, 1, GLP_FX, 0.0, 0.0);
   else
     glp_set_col_bnds(P, 1, GLP_FR, 0.0, 0.0);
-  glp_set_obj_coef(P, 1, 1.0);
+  glp_set_obj_coef(P, 1, objective == Objective::Lambda ? 1.0 : 0.0);
+  const double x_weight = free_moment_x / free_area_sum;  // x_G
 
   // Cone-edge columns.
   for (std::size_t c = 0; c < cols.size(); ++c) {
@@ -174,6 +215,11 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
     const Vec2 r = scaled(cols[c].end == 0 ? f.a : f.b);
     const double m = r.x * d.y - r.y * d.x;
     glp_set_col_bnds(P, col, GLP_LO, 0.0, 0.0);
+    if (thrust && 0.5 * (f.a.x + f.b.x) < x_weight) {
+      // Outward (-x) force on the fixed block of a left support interface (header).
+      if (model.blocks[f.block_b].fixed) glp_set_obj_coef(P, col, -d.x);
+      if (model.blocks[f.block_a].fixed) glp_set_obj_coef(P, col, d.x);
+    }
     if (const int rb = first_row[f.block_b]; rb > 0) {
       put(rb, col, d.x), put(rb + 1, col, d.y), put(rb + 2, col, m);
     }
@@ -224,7 +270,10 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
     res.status = "unbounded";
   else
     res.status = "error";
-  if (gravity_only) {
+  if (thrust) {
+    res.admissible = status == GLP_OPT || status == GLP_UNBND;
+    if (status == GLP_OPT) res.thrust = glp_get_obj_val(P) * newton;
+  } else if (gravity_only) {
     res.admissible = status == GLP_OPT;
   } else if (status == GLP_OPT) {
     res.lambda_la = glp_get_col_prim(P, 1);
@@ -321,5 +370,7 @@ LimitResult limit_analysis(const Model& model, double mu, double gravity, bool g
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
+
+}  // namespace
 
 }  // namespace voussoir

@@ -5,7 +5,9 @@
 // formulation is derived at the top of limit_analysis.cpp and in docs/limit.md.
 //
 // Uses: `voussoir limit` (drivers/command_limit.cpp); `voussoir capacity` seeds its bracket
-// with lambda_la; `voussoir stability` cross-checks cells with the gravity-only test.
+// with lambda_la; `voussoir stability` cross-checks cells with the gravity-only test;
+// `voussoir limit --thrust min|max` and `voussoir spread` compare the support thrust of a
+// moved structure with the least and greatest thrust (limit_thrust).
 
 #include <string>
 #include <vector>
@@ -51,6 +53,9 @@ struct LimitResult {
   std::string status;
   bool gravity_only = false;
   double lambda_la = 0.0;   // maximal load factor (NaN unless status is "optimal")
+  // limit_thrust: the least or greatest horizontal support thrust under gravity [N, per
+  // out_of_plane] (NaN unless status is "optimal"); NaN for limit_analysis.
+  double thrust = 0.0;
   bool admissible = false;  // an admissible equilibrium exists under self-weight alone
   bool exact = false;       // the optimal basis was confirmed in exact rational arithmetic
   std::vector<Interface> interfaces;      // every interface with at least one free block
@@ -75,6 +80,11 @@ struct LimitOptions {
   // is taken as not moving in the mechanism.
   double motion_tol = 1e-6;
   double interface_tol = 1e-9;  // find_interfaces rel_tol
+  // The interfaces to use instead of find_interfaces (null: found from the outlines). For
+  // blocks whose outlines no longer meet face to face: a structure whose supports moved opens
+  // its hinges, and its joints are then the reference ones carried with their blocks
+  // (drivers/capacity.hpp moved_blocks).
+  const std::vector<Interface>* interfaces = nullptr;
 };
 
 // Maximises lambda such that every free block is in equilibrium under its weight W = rho A
@@ -85,5 +95,19 @@ struct LimitOptions {
 LimitResult limit_analysis(const Model& model, double mu, double gravity, bool gravity_only);
 LimitResult limit_analysis(const Model& model, double mu, double gravity, bool gravity_only,
                            const LimitOptions& options);
+
+// Which extreme of the support thrust limit_thrust seeks.
+enum class ThrustBound { Min, Max };
+
+// The least (Min) or greatest (Max) horizontal thrust of the structure on its supports under
+// gravity alone (lambda = 0): the same equilibrium LP as limit_analysis with the horizontal
+// force on the supports as the objective (limit_analysis.cpp, "Thrust"). The thrust is the
+// outward horizontal force on the supports whose interfaces lie left of the free blocks' centre
+// of weight (under gravity alone it equals the outward force on those to its right). Status
+// "optimal" (LimitResult::thrust and the forces of that equilibrium), "infeasible" (no
+// admissible equilibrium under self-weight) or "unbounded" (Max: the thrust can grow without
+// limit, e.g. a flat arch). Throws as limit_analysis.
+LimitResult limit_thrust(const Model& model, double mu, double gravity, ThrustBound bound,
+                         const LimitOptions& options = LimitOptions{});
 
 }  // namespace voussoir

@@ -220,6 +220,33 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
   return model;
 }
 
+void check_fixed_indices(const SceneParams& params, std::size_t nb, const std::string& what) {
+  for (int f : params.model.fixed)
+    if (f < 0 || static_cast<std::size_t>(f) >= nb)
+      geometry_error(params, "model.fixed", f,
+                     "no such block: " + what + " has " + std::to_string(nb) +
+                         " blocks (indices 0.." + std::to_string(nb - 1) + ")");
+}
+
+namespace {
+
+// model.fixed on a generated scene (the polygons kind reads it itself): the listed blocks are
+// fixed as well as the scene's own supports, e.g. a church pier that is to settle with its
+// foundation ([supports], docs/supports.md). Every block fixed is refused as for polygons.
+void fix_listed_blocks(Scene& scene, const SceneParams& params) {
+  const ModelConfig& mc = params.model;
+  if (mc.kind == "polygons" || mc.fixed.empty()) return;
+  check_fixed_indices(params, scene.blocks.size(), "the model");
+  for (int f : mc.fixed) scene.blocks[std::size_t(f)].fixed = true;
+  std::size_t free = 0;
+  for (const BlockSpec& b : scene.blocks) free += b.fixed ? 0 : 1;
+  if (free == 0)
+    geometry_error(params, "model.fixed", mc.fixed.front(),
+                   "every block of the model would be fixed; leave at least one free");
+}
+
+}  // namespace
+
 Model build_model(const SceneParams& params) {
   // The checks of build_scene and the triangle budget catch the usual bad values; what still
   // fails inside the meshers (outlines that degenerate at extreme values, sizes whose boundary
@@ -228,6 +255,7 @@ Model build_model(const SceneParams& params) {
   const std::string where = params.deck_path.empty() ? std::string() : params.deck_path + ": ";
   try {
     Scene scene = build_scene(params);
+    fix_listed_blocks(scene, params);
     return mesh_scene(scene, params);
   } catch (const DeckError&) {
     throw;

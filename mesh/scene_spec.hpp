@@ -149,6 +149,10 @@ void check_triangle_budget(const SceneParams& params, double estimate);
 [[noreturn]] void geometry_error(const SceneParams& params, const std::string& key,
                                  const std::string& value, const std::string& why);
 
+// Throws DeckError naming model.fixed when one of its indices is not a block of the `nb`
+// blocks of `what` ("the file", "the model").
+void check_fixed_indices(const SceneParams& params, std::size_t nb, const std::string& what);
+
 // Chooses the cells of a voussoir-like band: n across the thickness t, m along the centreline
 // length L, from element size h, then refines whichever direction is too long so that the
 // cell aspect (along the intrados and the extrados, whose lengths are L (1 -+ q) with

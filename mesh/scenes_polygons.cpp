@@ -430,11 +430,7 @@ Scene build_polygons_scene(const SceneParams& params) {
   }
 
   const std::size_t nb = scene.blocks.size();
-  for (int f : mc.fixed)
-    if (f < 0 || static_cast<std::size_t>(f) >= nb)
-      geometry_error(params, "model.fixed", f,
-                     "no such block: the file has " + std::to_string(nb) + " blocks (indices 0.." +
-                         std::to_string(nb - 1) + ")");
+  check_fixed_indices(params, nb, "the file");
   for (std::size_t b = 0; b < nb; ++b) {
     const bool fixed =
         std::find(mc.fixed.begin(), mc.fixed.end(), static_cast<int>(b)) != mc.fixed.end();

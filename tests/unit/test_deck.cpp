@@ -97,6 +97,10 @@ local_damping_mode = "full"
 kinetic_damping = 0.01
 mass_scaling = "none"
 
+[supports]
+moves = [{block = 11, dx = -0.002, dy = 0.001, rotation = 0.5}, {block = 12, dy = -0.003}]
+ramp = 0.3
+
 [output]
 file = "run.h5"
 every = 0.02
@@ -200,6 +204,15 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.capacity.tolerance, 0.01);
   EXPECT_DOUBLE_EQ(c.capacity.local_damping, 0.6);
   EXPECT_EQ(c.capacity.local_damping_mode, "full");
+  ASSERT_EQ(c.supports.moves.size(), 2u);
+  EXPECT_EQ(c.supports.moves[0].block, 11);
+  EXPECT_DOUBLE_EQ(c.supports.moves[0].dx, -0.002);
+  EXPECT_DOUBLE_EQ(c.supports.moves[0].dy, 0.001);
+  EXPECT_DOUBLE_EQ(c.supports.moves[0].rotation, 0.5);
+  EXPECT_EQ(c.supports.moves[1].block, 12);
+  EXPECT_DOUBLE_EQ(c.supports.moves[1].dx, 0.0);
+  EXPECT_DOUBLE_EQ(c.supports.moves[1].dy, -0.003);
+  EXPECT_DOUBLE_EQ(c.supports.ramp, 0.3);
   EXPECT_DOUBLE_EQ(c.capacity.kinetic_damping, 0.01);
   EXPECT_EQ(c.capacity.mass_scaling, "none");
   EXPECT_EQ(c.output.file, "run.h5");  // output paths stay relative to the working directory

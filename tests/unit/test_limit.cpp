@@ -343,6 +343,72 @@ TEST(LimitChurch, SchemeBSolvesAndSchemeAIsNoStronger) {
               rb.lambda_la, rb.free_blocks, rb.wall_s, ra.lambda_la, ra.wall_s);
 }
 
+// ---------------------------------------------------------------- least and greatest thrust
+
+TEST(LimitThrust, TwoCantileversMeetingAtMidspan) {
+  // Two blocks w x h (w = 1, h = 0.5) meet on a vertical joint at x = 0; each rests on a fixed
+  // support only over its outer s = 0.2 (the support's top y = 0 ends at x = -/+(w - s)).
+  // By symmetry and convexity of the LP the extremes are symmetric, so the mid joint carries
+  // a horizontal force H at height y2 in (0, h] and no shear. The left block on its support:
+  // vertical reaction W, horizontal H (outward on the support), at x1 in [-w, -(w - s)].
+  // Moments about (x1, 0):  H y2 - W (-w/2 - x1) = 0,  H = W (-w/2 - x1) / y2.
+  // Least: x1 = -(w - s), y2 = h:  H_min = W (w/2 - s) / h = 0.6 W.
+  // Greatest: y2 -> 0 is geometrically free, so friction at the support binds: H_max = mu W.
+  for (const double mu : {0.8, 1.5}) {
+    Model m;
+    add_cut_rectangle(m, -1.5, -0.5, 0.7, 0.5, 1, 1, true);  // left support, top to x = -0.8
+    add_cut_rectangle(m, 0.8, -0.5, 0.7, 0.5, 1, 1, true);   // right support
+    add_cut_rectangle(m, -1.0, 0.0, 1.0, 0.5, 1, 1, false);  // left block
+    add_cut_rectangle(m, 0.0, 0.0, 1.0, 0.5, 1, 1, false);   // right block
+    finalize_model(m);
+    const double g = 9.81;
+    const double W = m.material.density * m.out_of_plane * g * 0.5;
+    const LimitResult lo = limit_thrust(m, mu, g, ThrustBound::Min);
+    ASSERT_EQ(lo.status, "optimal");
+    EXPECT_NEAR(lo.thrust, 0.6 * W, 1e-9 * W) << "mu " << mu;
+    EXPECT_TRUE(std::isnan(lo.lambda_la));
+    const PrimalCheck c = check_primal(m, lo, mu, g);
+    EXPECT_LT(c.equilibrium, 1e-9);
+    EXPECT_LT(c.cone, 1e-9);
+    const LimitResult hi = limit_thrust(m, mu, g, ThrustBound::Max);
+    ASSERT_EQ(hi.status, "optimal");
+    EXPECT_NEAR(hi.thrust, mu * W, 1e-9 * W) << "mu " << mu;
+  }
+}
+
+TEST(LimitThrust, LintelBetweenWallsHasNoGreatestThrust) {
+  // The same two blocks wedged between two fixed walls (a flat arch): the least thrust is
+  // W (w/2) / h (walls bear the whole height), the greatest unbounded.
+  Model m;
+  add_cut_rectangle(m, -1.5, 0.0, 0.5, 0.5, 1, 1, true);
+  add_cut_rectangle(m, 1.0, 0.0, 0.5, 0.5, 1, 1, true);
+  add_cut_rectangle(m, -1.0, 0.0, 1.0, 0.5, 1, 1, false);
+  add_cut_rectangle(m, 0.0, 0.0, 1.0, 0.5, 1, 1, false);
+  finalize_model(m);
+  const double W = m.material.density * 9.81 * 0.5;
+  const LimitResult lo = limit_thrust(m, 2.0, 9.81, ThrustBound::Min);
+  ASSERT_EQ(lo.status, "optimal");
+  EXPECT_NEAR(lo.thrust, W * 0.5 / 0.5, 1e-9 * W);
+  EXPECT_EQ(limit_thrust(m, 2.0, 9.81, ThrustBound::Max).status, "unbounded");
+}
+
+TEST(LimitThrust, SemicircularArchBetweenItsBounds) {
+  // The shipped arch (t/R = 0.2, 11 voussoirs, no sliding): min < max, both positive, the
+  // least thrust close to Heyman's continuous-arch value (docs/supports.md quotes both).
+  const Model m = case_model("circular_arch");
+  const LimitResult lo = limit_thrust(m, 10.0, 9.81, ThrustBound::Min);
+  const LimitResult hi = limit_thrust(m, 10.0, 9.81, ThrustBound::Max);
+  ASSERT_EQ(lo.status, "optimal");
+  ASSERT_EQ(hi.status, "optimal");
+  double weight = 0.0;
+  for (const Block& b : m.blocks)
+    if (!b.fixed) weight += b.mass * 9.81;
+  std::printf("semicircular arch: H_min / W = %.5f, H_max / W = %.5f\n", lo.thrust / weight,
+              hi.thrust / weight);
+  EXPECT_GT(lo.thrust, 0.0);
+  EXPECT_GT(hi.thrust, 1.2 * lo.thrust);
+}
+
 // ---------------------------------------------------------------- the command
 
 TEST(LimitCommand, WritesLambdaAndMechanismJson) {
