@@ -1,18 +1,18 @@
 #pragma once
 // Capacity curves (SPEC.md section 2, `voussoir pushover`; docs/pushover.md).
 //
-// A pushover is one quasi-static run from the settled state under gravity (settle(),
-// drivers/capacity.hpp) in which the horizontal load factor lambda follows the displacement d
-// of a control point, the centroid of the control block, measured along the load from the
-// settled state.
+// A pushover is one run (quasi-static unless its mechanism slides) from the settled state under
+// gravity (settle(), drivers/capacity.hpp) in which the horizontal load factor lambda follows the
+// displacement d of a control point, the centroid of the control block, measured along the load
+// from the settled state.
 //
 // Control: lambda is the force of a virtual spring, in load-factor units, between the control
 // point and a target that moves along the load at the constant `rate` v:
 //     lambda(t) = K (v t - d(t)),          K [1/m] the servo stiffness.
 // The lag v t - d = lambda / K does not enter the curve: its points are measured (d, lambda)
-// pairs. Why the spring// holds the structure past the peak: near a state of the curve lambda_c(d)
-// with tangent slope -s (s > 0 on the softening branch), the control point's generalized motion
-// obeys
+// pairs. Why the spring holds the structure past the peak: near a state of the curve
+// lambda_c(d) with tangent slope -s (s > 0 on the softening branch), the control point's
+// generalized motion obeys
 //     m d'' + c d' = W e (lambda - lambda_c(d)) = W e (K (v t - d) - lambda_c(d))
 // whose homogeneous part m p^2 + c p + W e (K - s) is stable when K > s: the spring holds the
 // structure on the softening branch where a force control (lambda given) would let it fall.
@@ -58,7 +58,8 @@
 // goes by jerks, whose friction work counts as statics), 0.2% above it in the physical run (no
 // local damping or mass scaling; the joints' default dashpot). The default ("auto") therefore runs
 // the physical pushover when the limit-analysis mechanism slides, the quasi-static one otherwise
-// (the physical run costs 2 to 5 times as much: the physical step, and the structure's ringing);
+// (the physical run cost 4 times as much on the regression cases: the physical step, no mass
+// scaling);
 // --dynamic and --quasi-static force one.
 //
 // Default rate: kRateFactor sqrt(g L_ref). On the semicircular arch, from 0.375 to 1.5 times
@@ -67,8 +68,8 @@
 // for the snap where the fourth hinge moves (d = 0.040-0.044 m) (docs/pushover.md).
 //
 // The run ends when lambda falls to 0 or below after the peak (the ultimate displacement d0,
-// interpolated between the two points around it), when it falls to stop_fraction of the peak
-// (asked for lambda* alone), when d reaches max_displacement, or at the time that the target
+// interpolated between the last two quasi-static windows), when it falls to stop_fraction of the
+// peak (asked for lambda* alone), when d reaches max_displacement, or at the time that the target
 // needs to reach max_displacement and twice the peak's lag.
 //
 // The equivalent single-degree-of-freedom curve of the kinematic analyses (Eurocode 8-3
@@ -97,7 +98,8 @@ inline constexpr double kRateFactor = 0.004;  // v = 0.004 sqrt(g L_ref)
 inline constexpr double kFastRate = 10.0;     // x v, while lambda < kFastFraction lambda_ref
 inline constexpr double kFastFraction = 0.5;
 // A window whose quasi-static load factor differs from the applied one by more than this x
-// lambda_ref is dynamic (a snap, a block falling): in the curve, not a candidate for the peak.
+// lambda_ref is dynamic (a snap, a block falling): left out of the curve (JSON
+// "dynamic_windows"), never the peak, never the end of the run.
 inline constexpr double kDynamicWindow = 0.1;
 inline constexpr double kMechanismWindow = 0.1;  // of the way from the peak to the end
 // A window of the quasi-static load factor closes when d has moved kWindowDisplacement x
