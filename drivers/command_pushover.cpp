@@ -111,7 +111,9 @@ int command_pushover(const Config& config, const CommonOptions& common,
     char title[200];
     std::snprintf(title, sizeof title, "%s: pushover end, d = %.4g m, lambda = %.4f",
                   std::filesystem::path(config.deck_path).stem().c_str(),
-                  r.curve.back().displacement, r.curve.back().lambda);
+                  r.curve.back().displacement,
+                  // no "-0.0000" for the small negative lambda that ends a curve
+                  std::abs(r.curve.back().lambda) < 5e-5 ? 0.0 : r.curve.back().lambda);
     draw_geometry(failure_mode_json(r.at_end, r.hinges_at_end), opts.picture,
                   {"--no-mesh", "--title", title});
   }
