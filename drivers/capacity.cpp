@@ -196,11 +196,10 @@ Model mirror_x(const Model& model) {
 }
 
 MovedBlocks moved_blocks(const Simulation& sim, bool mirror) {
-  Model reference = sim.model;
-  sync_rigid_nodes(reference);
-  const std::vector<BlockMotion> motion = block_motions(reference);
   MovedBlocks out;
-  out.model = reference;
+  out.model = sim.model;
+  sync_rigid_nodes(out.model);
+  const std::vector<BlockMotion> motion = block_motions(out.model);
   for (std::size_t b = 0; b < motion.size(); ++b)
     for (Vec2& p : out.model.blocks[b].polygon) p = move_point(motion[b], p);
   auto carried = [&](Index a, Index b, Vec2 p) {

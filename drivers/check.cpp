@@ -13,6 +13,7 @@
 #include "drivers/commands.hpp"
 #include "drivers/setup.hpp"
 #include "io/json.hpp"
+#include "limit/interfaces.hpp"
 #include "mesh/scene.hpp"
 
 namespace voussoir {
@@ -44,22 +45,31 @@ nlohmann::json model_geometry_json(const Model& model) {
           {"tri_block", tri_block}, {"blocks", blocks}, {"joints", joints}};
 }
 
-nlohmann::json failure_mode_json(const Model& model, const std::vector<Hinge>& hinges) {
-  using nlohmann::json;
-  json geo = model_geometry_json(model);
-  const std::vector<BlockMotion> motions = block_motions(model);
-  json reference = json::array();
+MovedOutlines moved_outlines(const Model& model) {
+  MovedOutlines out;
+  out.motions = block_motions(model);
+  out.moved = nlohmann::json::array();
+  out.reference = nlohmann::json::array();
   for (size_t b = 0; b < model.blocks.size(); ++b) {
-    json moved = json::array(), ref = json::array();
+    nlohmann::json moved = nlohmann::json::array(), ref = nlohmann::json::array();
     for (const Vec2& p : model.blocks[b].polygon) {
-      const Vec2 q = move_point(motions[b], p);
+      const Vec2 q = move_point(out.motions[b], p);
       moved.push_back({q.x, q.y});
       ref.push_back({p.x, p.y});
     }
-    geo["blocks"][b]["polygon"] = moved;
-    reference.push_back(ref);
+    out.moved.push_back(moved);
+    out.reference.push_back(ref);
   }
-  geo["reference_blocks"] = reference;
+  return out;
+}
+
+nlohmann::json failure_mode_json(const Model& model, const std::vector<Hinge>& hinges) {
+  using nlohmann::json;
+  json geo = model_geometry_json(model);
+  const MovedOutlines outlines = moved_outlines(model);
+  const std::vector<BlockMotion>& motions = outlines.motions;
+  for (size_t b = 0; b < model.blocks.size(); ++b) geo["blocks"][b]["polygon"] = outlines.moved[b];
+  geo["reference_blocks"] = outlines.reference;
   json marks = hinges_to_json(hinges);
   for (size_t k = 0; k < hinges.size(); ++k) {
     const Vec2 q = move_point(motions[hinges[k].block_a], Vec2{hinges[k].x, hinges[k].y});
@@ -94,8 +104,8 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   std::printf("supports   ");
   for (std::size_t b = 0; b < m.blocks.size(); ++b)
     if (m.blocks[b].fixed) {
-      Vec2 c{};
-      for (const Vec2& p : m.blocks[b].polygon) c = c + (1.0 / m.blocks[b].polygon.size()) * p;
+      Vec2 c;
+      polygon_centroid(m.blocks[b].polygon, &c);
       std::printf(" %zu (%s at %.3g, %.3g)", b, m.blocks[b].role.c_str(), c.x, c.y);
     }
   std::printf("\n");

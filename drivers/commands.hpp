@@ -37,6 +37,14 @@ nlohmann::json failure_mode_json(const Model& model, const std::vector<Hinge>& h
 
 nlohmann::json hinges_to_json(const std::vector<Hinge>& hinges);
 
+// Every block outline moved by its block's rigid motion (block_motions) and as drawn in the
+// reference configuration, as JSON polygons [[x, y], ...], block by block.
+struct MovedOutlines {
+  std::vector<BlockMotion> motions;
+  nlohmann::json moved, reference;
+};
+MovedOutlines moved_outlines(const Model& model);
+
 // --picture of `run` and `pulse`: the blocks of `sim` as they are (true displacements), the
 // reference outlines dashed, the line of thrust of this state, and the hinges (joints opened by
 // more than kHingeFraction x L_ref that still carry a force: blocks that have fallen apart are

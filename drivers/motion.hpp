@@ -62,6 +62,21 @@ inline double reference_length(const Model& model) {
   return std::isfinite(a) ? std::sqrt(a) : 1.0;
 }
 
+// Width and height of the free blocks' bounding box (reference outlines) [m]; 1 for an extent
+// that is empty or flat.
+struct FreeExtent {
+  double width = 1.0, height = 1.0;
+};
+inline FreeExtent free_extent(const Model& model) {
+  double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+  for (const Block& b : model.blocks)
+    if (!b.fixed)
+      for (const Vec2& p : b.polygon)
+        x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y),
+        y1 = std::max(y1, p.y);
+  return {x1 > x0 ? x1 - x0 : 1.0, y1 > y0 ? y1 - y0 : 1.0};
+}
+
 // At rest: the largest free-node speed has stayed below v_rest for the hold window, and the
 // kinetic energy is not growing over it (its peak over the second half of the window is no
 // larger than over the first half). The second condition tells a decaying oscillation from a
@@ -122,8 +137,7 @@ class CreepDetector {
   void add(double t, double m) {
     history_.push_back({t, m});
     // Keep one sample at or before t - hold (the start of the window).
-    while (history_.size() > 2 && history_[1].t <= t - hold_)
-      history_.pop_front();
+    while (history_.size() > 2 && history_[1].t <= t - hold_) history_.pop_front();
   }
   // Growth of m over the last hold window (the last sample against the one at or just before
   // its start); infinity while the history is shorter than the window.

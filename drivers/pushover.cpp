@@ -13,6 +13,7 @@
 #include "drivers/motion.hpp"
 #include "drivers/setup.hpp"
 #include "drivers/trial.hpp"
+#include "limit/interfaces.hpp"
 #include "limit/limit_analysis.hpp"
 
 namespace voussoir {
@@ -33,25 +34,11 @@ double centroid_x(const Model& m, int b) {
   return mx / mass;
 }
 
+// Block b's reference centroid (its outline's) [m].
 Vec2 reference_centroid(const Model& m, int b) {
-  const Block& blk = m.blocks[b];
-  double mx = 0.0, my = 0.0, mass = 0.0;
-  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
-    mx += m.nodes.mass[i] * m.nodes.x0[i];
-    my += m.nodes.mass[i] * m.nodes.y0[i];
-    mass += m.nodes.mass[i];
-  }
-  return {mx / mass, my / mass};
-}
-
-// Height of the free blocks' bounding box [m].
-double free_height(const Model& m) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const Block& b : m.blocks) {
-    if (b.fixed) continue;
-    for (const Vec2& p : b.polygon) lo = std::min(lo, p.y), hi = std::max(hi, p.y);
-  }
-  return hi > lo ? hi - lo : 1.0;
+  Vec2 c;
+  polygon_centroid(m.blocks[std::size_t(b)].polygon, &c);
+  return c;
 }
 
 // Sum over the free blocks of mass x centroid x [kg m] (true masses: the load's).
@@ -200,7 +187,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   r.rate = !std::isnan(set.rate) ? set.rate : kRateFactor * std::sqrt(std::max(g, 1e-12) * l_ref);
   r.max_displacement = !std::isnan(set.max_displacement)
                            ? set.max_displacement
-                           : kMaxDisplacementFraction * free_height(model);
+                           : kMaxDisplacementFraction * free_extent(model).height;
   // The quasi-static run: local damping as the settle, no kinetic damping (header comment).
   sim.ctx.kinetic_damping = 0.0;
 
@@ -380,24 +367,13 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
 
 namespace {
 
-// The free and fixed block outlines of `m` moved by each block's rigid motion, and their
-// reference outlines: what scripts/plot_pushover draws.
+// The block outlines of `m` moved by each block's rigid motion, their reference outlines and
+// which are fixed: what scripts/plot_pushover draws.
 nlohmann::json outlines_json(const Model& m) {
-  using nlohmann::json;
-  const std::vector<BlockMotion> motions = block_motions(m);
-  json blocks = json::array(), reference = json::array(), fixed = json::array();
-  for (std::size_t b = 0; b < m.blocks.size(); ++b) {
-    json moved = json::array(), ref = json::array();
-    for (const Vec2& p : m.blocks[b].polygon) {
-      const Vec2 q = move_point(motions[b], p);
-      moved.push_back({q.x, q.y});
-      ref.push_back({p.x, p.y});
-    }
-    blocks.push_back(moved);
-    reference.push_back(ref);
-    fixed.push_back(m.blocks[b].fixed);
-  }
-  return {{"blocks", blocks}, {"reference", reference}, {"fixed", fixed}};
+  nlohmann::json fixed = nlohmann::json::array();
+  for (const Block& b : m.blocks) fixed.push_back(b.fixed);
+  const MovedOutlines o = moved_outlines(m);
+  return {{"blocks", o.moved}, {"reference", o.reference}, {"fixed", fixed}};
 }
 
 }  // namespace

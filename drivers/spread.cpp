@@ -26,19 +26,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_from(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-// Extent of the free blocks along x [m].
-double free_width(const Model& model) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const Block& b : model.blocks)
-    if (!b.fixed)
-      for (const Vec2& p : b.polygon) lo = std::min(lo, p.x), hi = std::max(hi, p.x);
-  return hi > lo ? hi - lo : 1.0;
-}
-
 // The study's block: --block, else the deck's first move, else the leftmost fixed block.
 int study_block(const Config& config, const Model& model, const SpreadOptions& opts) {
   if (opts.block >= 0) return opts.block;
@@ -79,7 +66,7 @@ bool move_step(SettledState& s, const std::vector<SupportMove>& targets, double 
     const double tol = kHingeFraction * s.l_ref;
     out.hinges = find_hinges(sim.model, tol, tol);
   }
-  out.wall_s = seconds_from(t0);
+  out.wall_s = seconds_since(t0);
   return !out.collapsed;
 }
 
@@ -112,7 +99,7 @@ SpreadResult run_spread(const Config& given, const SpreadOptions& opts, bool qui
     throw DeckError(given.deck_path +
                     ": spread --direction: expected two numbers DX,DY, not both 0");
   res.direction = (1.0 / norm(e)) * e;
-  const double width = free_width(unmoved);
+  const double width = free_extent(unmoved).width;
   res.step = opts.step > 0.0 ? opts.step : 0.0025 * width;
   res.max_movement = opts.max_movement > 0.0 ? opts.max_movement : 0.25 * width;
   res.tolerance = opts.tolerance;
@@ -200,7 +187,7 @@ SpreadResult run_spread(const Config& given, const SpreadOptions& opts, bool qui
     report(st);
   }
   res.collapse_lo = lo;
-  res.wall_s = seconds_from(t0);
+  res.wall_s = seconds_since(t0);
   return res;
 }
 

@@ -78,12 +78,12 @@ SnapshotJoints snapshot_joints(const std::vector<JointResultant>& joints);
 void write_snapshot_thrust(RunWriter& writer, const Model& model, const ContactSystem& contact,
                            double dt, double lambda);
 
-// The outward horizontal force of the structure on its supports [N]: at every joint of
-// Model::joints with a fixed block, the horizontal component of the joint resultant on that
-// block, taken outward (-x left of the free blocks' centre of weight, +x right of it).
 // Abscissa of the free blocks' centre of weight (their reference outlines) [m].
 double free_weight_x(const Model& model);
 
+// The outward horizontal force of the structure on its supports [N]: at every joint of
+// Model::joints with a fixed block, the horizontal component of the joint resultant on that
+// block, taken outward (-x left of the free blocks' centre of weight, +x right of it).
 struct SupportThrust {
   double left = 0.0, right = 0.0;
   double mean() const { return 0.5 * (left + right); }
