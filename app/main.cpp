@@ -13,6 +13,7 @@
 
 #include "drivers/commands.hpp"
 #include "drivers/dealer.hpp"
+#include "drivers/ida.hpp"
 #include "drivers/limit_command.hpp"
 #include "drivers/pulse.hpp"
 #include "drivers/pushover.hpp"
@@ -121,13 +122,15 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   capacity->add_option("--max-time", cap_opts.criteria.max_time, "trial time limit [s]")
       ->check(CLI::PositiveNumber);
-  capacity->add_option("--direction", cap_opts.direction,
-                       "direction of lambda g: +x, -x, or both (reports each and the smaller)")
+  capacity
+      ->add_option("--direction", cap_opts.direction,
+                   "direction of lambda g: +x, -x, or both (reports each and the smaller)")
       ->check(CLI::IsMember({"+x", "-x", "both"}));
   capacity->add_flag("--dynamic", cap_opts.dynamic,
                      "physical settle and trials: no quasi-static local damping");
-  capacity->add_option("--settle-time", cap_opts.criteria.settle_max_time,
-                       "longest settle under gravity before the trials [s]")
+  capacity
+      ->add_option("--settle-time", cap_opts.criteria.settle_max_time,
+                   "longest settle under gravity before the trials [s]")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
 
@@ -258,6 +261,43 @@ int main(int argc, char** argv) {
   pulse->add_flag("--spectrum-only", pulse_opts.spectrum_only,
                   "write the spectrum and stop (no simulation)");
 
+  voussoir::IdaOptions ida_opts;
+  CLI::App* ida = app.add_subcommand(
+      "ida", "incremental dynamic analysis: collapse intensity per record, lognormal fragility");
+  add_common(ida, deck, common);
+  voussoir::add_limit_options(ida, common.limits);
+  ida->add_option("--records", ida_opts.records,
+                  "ground-motion records F1,F2,... (PEER .AT2 or two-column; docs/records.md)")
+      ->delimiter(',');
+  ida->add_option("--im", ida_opts.im,
+                  "intensity measure: pga (default) or sa (5%-damped Sa at --period)");
+  ida->add_option("--period", ida_opts.period, "period T of Sa(T) [s] (with --im sa)");
+  ida->add_option("--lambda-star", ida_opts.lambda_star,
+                  "tilting capacity to start from (skips the capacity search)");
+  ida->add_option("--points", ida_opts.points, "capacity trials per round (default 2)")
+      ->check(CLI::Range(1, 64));
+  ida->add_option("--start", ida_opts.start,
+                  "first intensity [g of the IM] (default: lambda* in PGA)");
+  ida->add_option("--step", ida_opts.step,
+                  "relative intensity step (default 0.1: each run 10% above the last)");
+  ida->add_option("--steps-above", ida_opts.steps_above,
+                  "runs past the first collapse, looking for survivals (default 2)");
+  ida->add_option("--tolerance", ida_opts.tolerance,
+                  "relative bracket width of the bisection (default 0.05)");
+  ida->add_option("--free-time", ida_opts.free_time,
+                  "free motion after the record before a timeout decision [s] (default 1.5)");
+  ida->add_option("--bootstrap", ida_opts.bootstrap,
+                  "bootstrap resamples for the median's interval (default 1000)");
+  ida->add_option("--confidence", ida_opts.confidence,
+                  "confidence level of the median's interval (default 0.95)");
+  ida->add_option("--seed", ida_opts.seed, "seed of the bootstrap (default 1)");
+  ida->add_option("--csv", ida_opts.csv,
+                  "a line per record (default ida.csv); the runs go to its stem + _runs.csv");
+  ida->add_option("--plot", ida_opts.plot,
+                  "PNG of the IDA points and the fragility (scripts/plot_ida)");
+  ida->add_option("--resume", ida_opts.resume,
+                  "journal of the runs: created, or resumed after a kill");
+
   voussoir::SweepOptions sweep_opts;
   CLI::App* sweep = app.add_subcommand("sweep", "capacity over a grid of deck values");
   add_common(sweep, deck, common);
@@ -298,9 +338,10 @@ int main(int argc, char** argv) {
   stability->add_option("--max-time", stab_opts.max_time,
                         "simulated time after which undecided cells are decided [s] (default 3)");
 
-  CLI::App* keys = app.add_subcommand(
-      "keys", "print the deck reference: every key, type, unit, default, allowed values "
-              "(docs/deck.md)");
+  CLI::App* keys =
+      app.add_subcommand("keys",
+                         "print the deck reference: every key, type, unit, default, allowed values "
+                         "(docs/deck.md)");
 
   try {
     app.parse(argc, argv);
@@ -312,8 +353,8 @@ int main(int argc, char** argv) {
 
   try {
     // Under mpirun these deal their cells to the ranks; any other command runs on rank 0 alone.
-    const bool dealt =
-        sweep->parsed() || stability->parsed() || (pulse->parsed() && pulse_opts.curve);
+    const bool dealt = sweep->parsed() || stability->parsed() || ida->parsed() ||
+                       (pulse->parsed() && pulse_opts.curve);
     if (!dealt && !speaks) return 0;
     if (keys->parsed()) {
       std::fputs(voussoir::deck_reference_markdown().c_str(), stdout);
@@ -330,6 +371,11 @@ int main(int argc, char** argv) {
     if (limit->parsed()) return voussoir::command_limit(config, common, limit_opts);
     if (pushover->parsed()) return voussoir::command_pushover(config, common, push_opts);
     if (spread->parsed()) return voussoir::command_spread(config, common, spread_opts);
+    if (ida->parsed()) {
+      ida_opts.period_given = ida->count("--period") > 0;
+      ida_opts.start_given = ida->count("--start") > 0;
+      return voussoir::command_ida(config, common, ida_opts);
+    }
     if (pulse->parsed()) {
       pulse_opts.start_given = pulse->count("--start") > 0;
       pulse_opts.tilt_reference_given = pulse->count("--tilt-reference") > 0;

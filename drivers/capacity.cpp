@@ -94,8 +94,8 @@ SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) 
     std::fprintf(stderr,
                  "settled under gravity: %s after %.3f s (%lld steps of %.4g s, %.2f s wall; "
                  "energy balance error %.2g)\n",
-                 s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"),
-                 s.settle_time, s.steps, sim.ctx.dt, s.wall_s, sim.ledger.balance_error());
+                 s.settled ? "at rest" : (s.collapsed ? "COLLAPSED" : "NOT at rest"), s.settle_time,
+                 s.steps, sim.ctx.dt, s.wall_s, sim.ledger.balance_error());
   if (s.settled && !sim.supports.empty()) move_supports_settled(s, config, crit, quiet);
   return s;
 }
@@ -289,13 +289,13 @@ RunSpec trial_spec(const SettledState& settled, double lambda, const TrialCriter
   spec.quiet = quiet;
   const double rot_limit = crit.collapse_rotation;
   spec.progress = [lambda, d_collapse, v_rest, rot_limit](const Probe& p, double wall) {
-    std::fprintf(stderr,
-                 "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
-                 "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
-                 lambda, p.time,
-                 100.0 * std::max(p.motion.displacement / d_collapse,
-                                  p.motion.rotation / rot_limit),
-                 p.speed / v_rest, wall);
+    std::fprintf(
+        stderr,
+        "  lambda = %.5f  running: %.3f s simulated, motion %.0f%% of the collapse "
+        "criterion, speed %.2g x the rest speed (%.0f s wall)\n",
+        lambda, p.time,
+        100.0 * std::max(p.motion.displacement / d_collapse, p.motion.rotation / rot_limit),
+        p.speed / v_rest, wall);
   };
   return spec;
 }
@@ -397,8 +397,8 @@ std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
   // The contact law: the settled positions need not show a change of friction or joint
   // stiffness (a block at rest under gravity alone sits the same at any friction).
   const ContactParams& cp = s.sim.contact.params();
-  for (double v : {cp.penalty, cp.friction, cp.normal_stiffness, cp.joint_young,
-                   cp.shear_stiffness, cp.restitution})
+  for (double v : {cp.penalty, cp.friction, cp.normal_stiffness, cp.joint_young, cp.shear_stiffness,
+                   cp.restitution})
     f.value(v);
   return f.hex();
 }

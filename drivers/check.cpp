@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <vector>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "contact/friction.hpp"
 #include "contact/joint_stiffness.hpp"
@@ -41,7 +41,7 @@ nlohmann::json model_geometry_json(const Model& model) {
                       {"a", {j.a.x, j.a.y}},
                       {"b", {j.b.x, j.b.y}},
                       {"position_deg", j.position_deg}});
-  return {{"kind", model.kind}, {"nodes", nodes},   {"triangles", tris},
+  return {{"kind", model.kind},     {"nodes", nodes},   {"triangles", tris},
           {"tri_block", tri_block}, {"blocks", blocks}, {"joints", joints}};
 }
 
@@ -136,9 +136,10 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   const std::size_t fastest =
       std::size_t(std::min_element(each_body.begin(), each_body.end()) - each_body.begin());
   if (!body_steps.empty()) {
-    std::printf("body steps  min %.4g s (block %zu), median %.4g s, max %.4g s: each free block "
-                "alone on its joints\n",
-                body_steps.front(), fastest, body_steps[body_steps.size() / 2], body_steps.back());
+    std::printf(
+        "body steps  min %.4g s (block %zu), median %.4g s, max %.4g s: each free block "
+        "alone on its joints\n",
+        body_steps.front(), fastest, body_steps[body_steps.size() / 2], body_steps.back());
   }
   if (info.joint_stiffness) {
     if (config.contact.normal_stiffness > 0.0)
@@ -147,10 +148,9 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                       ? config.contact.shear_stiffness
                       : kTangentialStiffnessRatio * config.contact.normal_stiffness);
     else
-      std::printf(
-          "joints      kn = %g E / L per joint (L: the joint's length), ks = %s\n",
-          kRigidJointFactor,
-          config.contact.shear_stiffness > 0.0 ? "contact.shear_stiffness" : "kn / 4");
+      std::printf("joints      kn = %g E / L per joint (L: the joint's length), ks = %s\n",
+                  kRigidJointFactor,
+                  config.contact.shear_stiffness > 0.0 ? "contact.shear_stiffness" : "kn / 4");
   } else {
     std::printf("penalty     %.4g Pa\n", info.penalty);
   }

@@ -6,10 +6,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-#include <nlohmann/json.hpp>
 
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
@@ -64,16 +64,17 @@ namespace {
 void print_capacity(const CapacityResult& res, const CapacityOptions& opts) {
   // No collapse: no lambda*, only the highest lambda that stood.
   if (res.bracketed)
-    std::printf("lambda* = %.4f  bracket [%.4f, %.4f]  %zu trials  %.1f s wall\n",
-                res.lambda_star, res.lo, res.hi, res.trials.size(), res.wall_s);
+    std::printf("lambda* = %.4f  bracket [%.4f, %.4f]  %zu trials  %.1f s wall\n", res.lambda_star,
+                res.lo, res.hi, res.trials.size(), res.wall_s);
   else
     std::printf("%s = %.4f (every trial stood)  %zu trials  %.1f s wall\n", kNoCollapse, res.lo,
                 res.trials.size(), res.wall_s);
   if (res.seed.used)
-    std::printf("seeded from limit analysis lambda_la = %.4f: %s, %d trials against about %d "
-                "unseeded\n",
-                res.seed.lambda_la, res.seed.held ? "bracket held" : "bracket widened",
-                static_cast<int>(res.trials.size()), res.seed.unseeded_trials);
+    std::printf(
+        "seeded from limit analysis lambda_la = %.4f: %s, %d trials against about %d "
+        "unseeded\n",
+        res.seed.lambda_la, res.seed.held ? "bracket held" : "bracket widened",
+        static_cast<int>(res.trials.size()), res.seed.unseeded_trials);
   if (res.resumed_trials > 0)
     std::printf("%d trials taken from the journal %s\n", res.resumed_trials, opts.resume.c_str());
   if (res.ahead > 0)
@@ -98,42 +99,38 @@ nlohmann::json capacity_json(const CapacityResult& res, const CapacityOptions& o
   }
   const nlohmann::json none(nullptr);
   nlohmann::json j = {
-          {"lambda_star", res.bracketed ? nlohmann::json(res.lambda_star) : none},
-          {"bracket", {res.lo, res.bracketed ? nlohmann::json(res.hi) : none}},
-          {"bracketed", res.bracketed},
-          {"result", res.bracketed ? "collapse" : kNoCollapse},
-          {"failure_mode", failure_mode_text(res)},
-          {"tolerance", res.tolerance},
-          {"runs", runs},
-          {"triangles", res.triangles},
-          {"dt", res.dt},
-          {"wall_s", res.wall_s},
-          {"settle",
-           {{"sim_time", res.settle_time},
-            {"steps", res.settle_steps},
-            {"wall_s", res.settle_wall_s}}},
-          {"points_per_round", opts.points},
-          {"hinges", hinges_to_json(res.hinges)},
-          {"resumed_trials", res.resumed_trials},
-          // Trials run ahead on idle cores (drivers/trial_pool.hpp): timing, like wall_s.
-          {"ahead",
-           {{"workers", res.workers},
-            {"started", res.ahead},
-            {"used", res.ahead_used},
-            {"cancelled", res.ahead_cancelled},
-            {"unused_wall_s", res.ahead_unused_s}}},
-          {"seed",
-           {{"used", res.seed.used},
-            {"limit_status", res.seed.status},
-            {"lambda_la",
-             res.seed.used ? nlohmann::json(res.seed.lambda_la) : nlohmann::json(nullptr)},
-            {"held", res.seed.held},
-            {"ends_run", res.seed.ends_run},
-            {"widenings", res.seed.widenings},
-            {"unseeded_trials_estimate", res.seed.unseeded_trials},
-            {"trials_saved", res.seed.used ? res.seed.unseeded_trials -
-                                                 static_cast<int>(res.trials.size())
-                                           : 0}}}};
+      {"lambda_star", res.bracketed ? nlohmann::json(res.lambda_star) : none},
+      {"bracket", {res.lo, res.bracketed ? nlohmann::json(res.hi) : none}},
+      {"bracketed", res.bracketed},
+      {"result", res.bracketed ? "collapse" : kNoCollapse},
+      {"failure_mode", failure_mode_text(res)},
+      {"tolerance", res.tolerance},
+      {"runs", runs},
+      {"triangles", res.triangles},
+      {"dt", res.dt},
+      {"wall_s", res.wall_s},
+      {"settle",
+       {{"sim_time", res.settle_time}, {"steps", res.settle_steps}, {"wall_s", res.settle_wall_s}}},
+      {"points_per_round", opts.points},
+      {"hinges", hinges_to_json(res.hinges)},
+      {"resumed_trials", res.resumed_trials},
+      // Trials run ahead on idle cores (drivers/trial_pool.hpp): timing, like wall_s.
+      {"ahead",
+       {{"workers", res.workers},
+        {"started", res.ahead},
+        {"used", res.ahead_used},
+        {"cancelled", res.ahead_cancelled},
+        {"unused_wall_s", res.ahead_unused_s}}},
+      {"seed",
+       {{"used", res.seed.used},
+        {"limit_status", res.seed.status},
+        {"lambda_la", res.seed.used ? nlohmann::json(res.seed.lambda_la) : nlohmann::json(nullptr)},
+        {"held", res.seed.held},
+        {"ends_run", res.seed.ends_run},
+        {"widenings", res.seed.widenings},
+        {"unseeded_trials_estimate", res.seed.unseeded_trials},
+        {"trials_saved",
+         res.seed.used ? res.seed.unseeded_trials - static_cast<int>(res.trials.size()) : 0}}}};
   // The line of thrust (drivers/thrust.hpp): settled, last stable trial, collapsed trial.
   j["joints"] = joints_json(res.joints_settled);
   if (res.has_stable) j["joints_stable"] = joints_json(res.joints_stable);
@@ -184,8 +181,7 @@ void write_movie(const CapacityResult& res, const CapacityOptions& opts, const s
                 std::filesystem::path(deck).stem().c_str(), res.lambda_star);
   if (draw_with_script("animate", {h5, "-o", opts.movie, "--label", label}, opts.movie))
     std::printf("movie %s: %d frames, %.3f s of the trial (collapse criterion at %.3f s)\n",
-                opts.movie.c_str(), res.movie.frames, res.movie.duration,
-                res.movie.collapse_time);
+                opts.movie.c_str(), res.movie.frames, res.movie.duration, res.movie.collapse_time);
 }
 
 }  // namespace
@@ -222,8 +218,7 @@ int command_capacity(const Config& config, const CommonOptions& common,
     CapacitySearch s = search;
     if (directions.size() > 1 && !s.journal.empty()) s.journal += d == "-x" ? ".-x" : ".+x";
     if (!opts.movie.empty()) s.movie = movie_h5(opts, d);
-    if (directions.size() > 1 && !common.quiet)
-      std::fprintf(stderr, "direction %s\n", d.c_str());
+    if (directions.size() > 1 && !common.quiet) std::fprintf(stderr, "direction %s\n", d.c_str());
     results.push_back(find_capacity(config, c, s));
   }
   std::size_t governing = 0;
@@ -239,8 +234,7 @@ int command_capacity(const Config& config, const CommonOptions& common,
                 results[governing].lambda_star);
   write_mode(results[governing], opts, config.deck_path);
   if (!opts.movie.empty()) {
-    write_movie(results[governing], opts, movie_h5(opts, directions[governing]),
-                config.deck_path);
+    write_movie(results[governing], opts, movie_h5(opts, directions[governing]), config.deck_path);
     for (const std::string& d : directions) {
       std::remove(movie_h5(opts, d).c_str());
       std::remove(xdmf_path_for(movie_h5(opts, d)).c_str());

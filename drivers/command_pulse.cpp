@@ -250,43 +250,12 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   crit.settle.limits = common.limits;
   crit.free_time = opts.free_time;
 
-  // Under mpirun only rank 0 (which prints) searches the tilting capacity; the other ranks
-  // wait for its lambda* (or for its failure, and stop without a word: rank 0 reports it).
   const bool quiet = common.quiet || !is_dealer_rank();
-  double lambda_star = opts.lambda_star;
-  double capacity_wall = 0.0;
-  if (lambda_star < 0.0) {
-    nlohmann::json found;
-    std::exception_ptr failure;
-    if (is_dealer_rank()) try {
-        if (!quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
-        CapacitySearch capacity_search;
-        capacity_search.points = opts.points;
-        capacity_search.quiet = quiet;
-        if (!opts.resume.empty()) capacity_search.journal = opts.resume + ".capacity";
-        const CapacityResult cap = find_capacity(config, crit.settle, capacity_search);
-        // Without a collapse there is no tilting capacity, hence no quasi-static limit to start
-        // the curve from or to compare it with.
-        if (!cap.bracketed) {
-          char buf[200];
-          std::snprintf(buf, sizeof buf,
-                        "the tilting capacity search found %s = %.4f: no quasi-static limit for "
-                        "the curve (give one with --lambda-star)",
-                        kNoCollapse, cap.lo);
-          throw RunError(buf);
-        }
-        found = {{"lambda_star", cap.lambda_star}, {"wall_s", cap.wall_s}};
-      } catch (...) {
-        failure = std::current_exception();
-        found = {{"failed", true}};
-      }
-    found = share_from_dealer(found);
-    if (failure) std::rethrow_exception(failure);
-    if (found.is_null() || found.contains("failed")) return 1;
-    lambda_star = found["lambda_star"];
-    capacity_wall = found["wall_s"];
-    if (!quiet) std::fprintf(stderr, "lambda* = %.4f (%.1f s wall)\n", lambda_star, capacity_wall);
-  }
+  const std::optional<TiltingCapacity> capacity =
+      study_capacity(config, crit.settle, opts.lambda_star, opts.points, opts.resume, quiet);
+  if (!capacity) return 1;
+  const double lambda_star = capacity->lambda_star;
+  const double capacity_wall = capacity->wall_s;
   // Peak of the unit-amplitude pulse (0.891 for the 3-cycle windowed sine, 1 for one sine):
   // the quasi-static limit of the curve is A = lambda* / peak_factor.
   const double peak_factor = make_base_signal(config.load.base, 1.0, 1.0, 1.0).peak_acceleration();
@@ -311,65 +280,34 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   // The costliest frequencies first for the dynamic schedule: for the bisection the lowest (the
   // longest pulses), for the stepping search the highest (the most steps from the quasi-static
   // start: 51 runs at 12 Hz against 6 at 2 Hz on scaled_arch). The order changes no result.
-  std::vector<double> freqs = opts.freqs;
-  std::vector<int> order(freqs.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  const std::vector<double>& freqs = opts.freqs;
+  std::vector<std::size_t> order(freqs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   const bool highest_first = search.search == AmplitudeSearch::Step;
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return highest_first ? freqs[a] > freqs[b] : freqs[a] < freqs[b];
   });
-  std::vector<CurvePoint> points(freqs.size());
-  std::vector<std::string> errors(freqs.size());
-  // The frequencies are the cells (drivers/dealer.hpp), dealt in the order above. In one
-  // process every run is journalled as it finishes; under mpirun a frequency takes its runs
-  // already journalled with it, and rank 0 journals its new runs when the frequency comes back.
-  const bool spread = rank_count() > 1 && runs_journal;
-  auto runs_at = [&](double frequency) {
-    nlohmann::json runs = nlohmann::json::array();
-    for (const nlohmann::json& j : journal.records())
-      if (j.value("frequency", -1.0) == frequency) runs.push_back(j);
-    return runs;
-  };
-  CellWork work;
-  work.cells = freqs.size();
-  if (spread) work.input = [&](size_t k) { return runs_at(freqs[order[k]]); };
-  work.run = [&](size_t k, const nlohmann::json& given) {
-    const int i = order[k];
-    Journal share(given.is_array() ? given.get<std::vector<nlohmann::json>>()
-                                   : std::vector<nlohmann::json>());
-    CurvePoint p;
-    std::string error;
-    try {
-      // Under mpirun the progress is a line per frequency, printed by rank 0 as it arrives.
-      p = find_collapse_amplitude(settled, config.load.base, freqs[i], search, crit,
-                                  quiet || rank_count() > 1, spread ? &share : runs_journal);
-    } catch (const std::exception& e) {
-      error = e.what();
-      p.frequency = freqs[i];
-    }
-    nlohmann::json record = curve_point_record(p);
-    record["error"] = error;
-    return record;
-  };
-  work.take = [&](size_t k, const nlohmann::json& record) {
-    const int i = order[k];
-    points[i] = curve_point_from_record(record);
-    errors[i] = record.at("error");
-    if (spread) {
-      const nlohmann::json known = runs_at(freqs[i]);
-      for (const nlohmann::json& run : record.at("runs"))
-        if (std::none_of(known.begin(), known.end(), [&](const nlohmann::json& j) {
-              return j.at("amplitude") == run.at("amplitude");
-            }))
-          journal.append(run);
-    }
-    if (!quiet)
-      std::fprintf(stderr, "f = %.3f Hz: A = %.4f g (%d trials, %.1f s wall)%s%s\n", freqs[i],
-                   points[i].amplitude, points[i].trials, points[i].wall_s,
-                   errors[i].empty() ? "" : " error: ", errors[i].c_str());
-  };
-  deal_cells(work, common.threads, quiet);
+  std::vector<SearchCell> cells(freqs.size());
+  for (std::size_t i = 0; i < freqs.size(); ++i) {
+    cells[i].base = config.load.base;
+    cells[i].frequency = freqs[i];
+    cells[i].search = search;
+  }
+  const std::vector<SearchOutcome> outcomes = deal_searches(
+      settled, cells, order, crit, common.threads, quiet, runs_journal,
+      [&](std::size_t i, const SearchOutcome& out) {
+        if (!quiet)
+          std::fprintf(stderr, "f = %.3f Hz: A = %.4f g (%d trials, %.1f s wall)%s%s\n", freqs[i],
+                       out.point.amplitude, out.point.trials, out.point.wall_s,
+                       out.error.empty() ? "" : " error: ", out.error.c_str());
+      });
   if (!is_dealer_rank()) return 0;  // rank 0 writes the outputs (drivers/dealer.hpp)
+  std::vector<CurvePoint> points;
+  std::vector<std::string> errors;
+  for (const SearchOutcome& out : outcomes) {
+    points.push_back(out.point);
+    errors.push_back(out.error);
+  }
   const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
 
   auto list_of = [](const std::vector<double>& v, const char* sep) {
@@ -488,8 +426,9 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
 int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
   validate_pulse_options(opts);
   if (opts.curve && !opts.picture.empty())
-    throw DeckError("--picture draws a single pulse run's final state: not with --curve (the "
-                    "curve's picture is --plot)");
+    throw DeckError(
+        "--picture draws a single pulse run's final state: not with --curve (the "
+        "curve's picture is --plot)");
   if (opts.spectrum.empty() && (opts.spectrum_only || !opts.spectrum_plot.empty()))
     throw DeckError(std::string(opts.spectrum_only ? "--spectrum-only" : "--spectrum-plot") +
                     " needs --spectrum FILE.csv");

@@ -112,13 +112,11 @@ std::string checkpoint_path(const RunOptions& opts, const std::string& out_path,
   return (stem.empty() ? std::string("run") : stem) + ".ckpt";
 }
 
-
 }  // namespace
 
 void draw_current_state(const Simulation& sim, const std::string& title,
                         const std::string& picture) {
-  const std::vector<JointResultant> joints =
-      joint_resultants(sim.model, sim.contact, sim.ctx.dt);
+  const std::vector<JointResultant> joints = joint_resultants(sim.model, sim.contact, sim.ctx.dt);
   const double tol = kHingeFraction * reference_length(sim.model);
   std::vector<Hinge> hinges;
   for (const Hinge& h : find_hinges(sim.model, tol, tol))

@@ -12,9 +12,9 @@
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/dealer.hpp"
-#include "drivers/plot.hpp"
 #include "drivers/grid.hpp"
 #include "drivers/journal.hpp"
+#include "drivers/plot.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
@@ -161,9 +161,9 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
     if (ok && r.bracketed) csv << r.lambda_star;
     csv << ',' << r.lo << ',';
     if (r.bracketed) csv << r.hi;
-    csv << ',' << (r.bracketed ? 1 : 0) << ',' << mode << ','
-        << joint_list(r.hinges, "hinge") << ',' << joint_list(r.hinges, "sliding") << ','
-        << r.trials.size() << ',' << r.wall_s << ',' << csv_quote(errors[c]) << '\n';
+    csv << ',' << (r.bracketed ? 1 : 0) << ',' << mode << ',' << joint_list(r.hinges, "hinge")
+        << ',' << joint_list(r.hinges, "sliding") << ',' << r.trials.size() << ',' << r.wall_s
+        << ',' << csv_quote(errors[c]) << '\n';
     jcells.push_back({{"params", params},
                       {"lambda_star", ok && r.bracketed ? nlohmann::json(r.lambda_star) : none},
                       {"bracket", {r.lo, r.bracketed ? nlohmann::json(r.hi) : none}},
@@ -178,11 +178,11 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   csv.close();
   if (std::rename((csv_path + ".tmp").c_str(), csv_path.c_str()) != 0)
     throw OutputError("cannot write " + csv_path);
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("sweep of %zu cells written to %s (%.1f s wall)\n", cells, csv_path.c_str(), wall);
   if (!common.json_path.empty())
-    write_json({{"cells", jcells}, {"csv", csv_path}, {"ranks", rank_count()}, {"wall_s", wall}}, common.json_path);
+    write_json({{"cells", jcells}, {"csv", csv_path}, {"ranks", rank_count()}, {"wall_s", wall}},
+               common.json_path);
   if (!opts.plot.empty()) {
     draw_with_script("plot_sweep", {csv_path, "-o", opts.plot}, opts.plot);
   }

@@ -23,8 +23,8 @@ std::vector<Hinge> hinges_from_record(const nlohmann::json& record) {
   };
   std::vector<Hinge> out;
   for (const auto& h : record)
-    out.push_back(Hinge{h[0], h[1], h[2], h[3], h[4], num(h[5]), num(h[6]), num(h[7]), num(h[8]),
-                        num(h[9])});
+    out.push_back(
+        Hinge{h[0], h[1], h[2], h[3], h[4], num(h[5]), num(h[6]), num(h[7]), num(h[8]), num(h[9])});
   return out;
 }
 

@@ -28,21 +28,23 @@ std::string quoted(const std::string& s) {
 bool draw_with_script(const std::string& script, const std::vector<std::string>& args,
                       const std::string& output) {
   if (access(kPython, X_OK) != 0) {
-    std::fprintf(stderr, "voussoir: warning: %s could not be drawn: no %s (install python3 and "
-                 "python3-matplotlib)\n", output.c_str(), kPython);
+    std::fprintf(stderr,
+                 "voussoir: warning: %s could not be drawn: no %s (install python3 and "
+                 "python3-matplotlib)\n",
+                 output.c_str(), kPython);
     return false;
   }
-  std::string cmd = std::string(kPython) + " " +
-                    quoted(std::string(VOUSSOIR_SOURCE_DIR) + "/scripts/" + script);
+  std::string cmd =
+      std::string(kPython) + " " + quoted(std::string(VOUSSOIR_SOURCE_DIR) + "/scripts/" + script);
   for (const std::string& a : args) cmd += " " + quoted(a);
   std::fflush(stdout);  // our summary before the script's lines
   const int status = std::system(cmd.c_str());
   if (status == 0) return true;
   const int code = status > 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::fprintf(stderr, "voussoir: warning: %s could not be drawn: scripts/%s %s\n",
-               output.c_str(), script.c_str(),
-               code >= 0 ? ("exited with status " + std::to_string(code)).c_str()
-                         : "could not be run");
+  std::fprintf(
+      stderr, "voussoir: warning: %s could not be drawn: scripts/%s %s\n", output.c_str(),
+      script.c_str(),
+      code >= 0 ? ("exited with status " + std::to_string(code)).c_str() : "could not be run");
   return false;
 }
 

@@ -8,11 +8,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <limits>
 
 #include "core/fnv.hpp"
 #include "core/rigid.hpp"
 #include "drivers/bracket.hpp"
+#include "drivers/dealer.hpp"
 #include "drivers/motion.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
@@ -314,19 +316,33 @@ PulseResult pulse_run_from_record(const nlohmann::json& j) {
 }
 
 // nlohmann's conversions of a run (its journal record) and of a point, field by field.
-void to_json(nlohmann::json& j, const PulseResult& r) { j = pulse_run_record(r); }
-void from_json(const nlohmann::json& j, PulseResult& r) { r = pulse_run_from_record(j); }
+void to_json(nlohmann::json& j, const PulseResult& r) {
+  j = pulse_run_record(r);
+}
+void from_json(const nlohmann::json& j, PulseResult& r) {
+  r = pulse_run_from_record(j);
+}
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(CurvePoint, frequency, amplitude, lo, hi, bracketed, trials,
                                    wall_s, max_energy_balance_error, stable_above, runs)
 
-nlohmann::json curve_point_record(const CurvePoint& point) { return point; }
+nlohmann::json curve_point_record(const CurvePoint& point) {
+  return point;
+}
 CurvePoint curve_point_from_record(const nlohmann::json& record) {
   return record.get<CurvePoint>();
 }
 
+bool same_search(const nlohmann::json& run, double frequency, const SearchKey& key) {
+  if (run.value("frequency", -1.0) != frequency) return false;
+  for (const auto& [name, value] : key.fields.items())
+    if (!run.contains(name) || run.at(name) != value) return false;
+  return true;
+}
+
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
                                    double frequency, const AmplitudeSearchOptions& search,
-                                   const PulseCriteria& crit, bool quiet, Journal* journal) {
+                                   const PulseCriteria& crit, bool quiet, Journal* journal,
+                                   const SearchKey& key) {
   const auto wall0 = Clock::now();
   CurvePoint cp;
   cp.frequency = frequency;
@@ -336,7 +352,7 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     bool found = false;
 #pragma omp critical(pulse_journal)
     for (const nlohmann::json& j : journal->records())
-      if (j.value("frequency", -1.0) == frequency && j.value("amplitude", -1.0) == a) {
+      if (same_search(j, frequency, key) && j.value("amplitude", -1.0) == a) {
         r = pulse_run_from_record(j);
         found = true;
         break;
@@ -353,16 +369,21 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
       r.frequency = frequency;
       r.control.clear();  // not needed per trial
       if (journal) {
+        nlohmann::json record = pulse_run_record(r);
+        record.update(key.fields);
 #pragma omp critical(pulse_journal)
-        journal->append(pulse_run_record(r));
+        journal->append(record);
       }
     }
     cp.max_energy_balance_error = std::max(cp.max_energy_balance_error, r.max_energy_balance_error);
-    if (!quiet)
-      std::fprintf(stderr,
-                   "  f = %6.3f Hz  A = %.5f g  %-9s (%s at t = %.3f s, %lld steps, %.1f s wall)%s\n",
-                   frequency, a, r.collapsed ? "collapsed" : "survived", r.reason.c_str(),
-                   r.decided_at, r.steps, r.wall_s, resumed ? " [journal]" : "");
+    if (!quiet) {
+      char name[64];
+      std::snprintf(name, sizeof name, "f = %6.3f Hz", frequency);
+      std::fprintf(stderr, "  %s  A = %.5f g  %-9s (%s at t = %.3f s, %lld steps, %.1f s wall)%s\n",
+                   key.label.empty() ? name : key.label.c_str(), a,
+                   r.collapsed ? "collapsed" : "survived", r.reason.c_str(), r.decided_at, r.steps,
+                   r.wall_s, resumed ? " [journal]" : "");
+    }
     cp.runs.push_back(r);
     return r.collapsed;
   };
@@ -422,6 +443,98 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
   cp.trials = static_cast<int>(cp.runs.size());
   cp.wall_s = seconds_since(wall0);
   return cp;
+}
+
+std::optional<TiltingCapacity> study_capacity(const Config& config, const TrialCriteria& settle,
+                                              double given, int points, const std::string& resume,
+                                              bool quiet) {
+  if (given >= 0.0) return TiltingCapacity{given, 0.0, false};
+  nlohmann::json found;
+  std::exception_ptr failure;
+  if (is_dealer_rank()) try {
+      if (!quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
+      CapacitySearch capacity_search;
+      capacity_search.points = points;
+      capacity_search.quiet = quiet;
+      if (!resume.empty()) capacity_search.journal = resume + ".capacity";
+      const CapacityResult cap = find_capacity(config, settle, capacity_search);
+      // Without a collapse there is no tilting capacity, hence no quasi-static limit to start
+      // the searches from or to compare them with.
+      if (!cap.bracketed) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "the tilting capacity search found %s = %.4f: no quasi-static limit to "
+                      "start from (give one with --lambda-star)",
+                      kNoCollapse, cap.lo);
+        throw RunError(buf);
+      }
+      found = {{"lambda_star", cap.lambda_star}, {"wall_s", cap.wall_s}};
+    } catch (...) {
+      failure = std::current_exception();
+      found = {{"failed", true}};
+    }
+  found = share_from_dealer(found);
+  if (failure) std::rethrow_exception(failure);
+  if (found.is_null() || found.contains("failed")) return std::nullopt;
+  TiltingCapacity out{found["lambda_star"], found["wall_s"], true};
+  if (!quiet) std::fprintf(stderr, "lambda* = %.4f (%.1f s wall)\n", out.lambda_star, out.wall_s);
+  return out;
+}
+
+std::vector<SearchOutcome> deal_searches(
+    const SettledState& settled, const std::vector<SearchCell>& cells,
+    const std::vector<std::size_t>& order, const PulseCriteria& crit, int threads, bool quiet,
+    Journal* journal, const std::function<void(std::size_t, const SearchOutcome&)>& done) {
+  std::vector<SearchOutcome> outcomes(cells.size());
+  const bool spread = rank_count() > 1 && journal;
+  auto runs_of = [&](const SearchCell& cell) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const nlohmann::json& j : journal->records())
+      if (same_search(j, cell.frequency, cell.key)) runs.push_back(j);
+    return runs;
+  };
+  CellWork work;
+  work.cells = cells.size();
+  if (spread) work.input = [&](std::size_t k) { return runs_of(cells[order[k]]); };
+  work.run = [&](std::size_t k, const nlohmann::json& given) {
+    const SearchCell& cell = cells[order[k]];
+    Journal share(given.is_array() ? given.get<std::vector<nlohmann::json>>()
+                                   : std::vector<nlohmann::json>());
+    CurvePoint p;
+    std::string error;
+    try {
+      // Under mpirun the progress is a line per search, printed by rank 0 as it arrives.
+      p = find_collapse_amplitude(settled, cell.base, cell.frequency, cell.search, crit,
+                                  quiet || rank_count() > 1, spread ? &share : journal, cell.key);
+    } catch (const std::exception& e) {
+      error = e.what();
+      p.frequency = cell.frequency;
+    }
+    nlohmann::json record = curve_point_record(p);
+    record["error"] = error;
+    return record;
+  };
+  work.take = [&](std::size_t k, const nlohmann::json& record) {
+    const std::size_t i = order[k];
+    SearchOutcome& out = outcomes[i];
+    out.point = curve_point_from_record(record);
+    out.error = record.at("error");
+    if (spread) {
+      const nlohmann::json known = runs_of(cells[i]);
+      for (const nlohmann::json& run : record.at("runs"))
+        if (std::none_of(known.begin(), known.end(), [&](const nlohmann::json& j) {
+              return j.at("amplitude") == run.at("amplitude");
+            })) {
+          nlohmann::json tagged = run;
+          tagged.update(cells[i].key.fields);
+          journal->append(tagged);
+        }
+    }
+    if (done) done(i, out);
+  };
+  deal_cells(work, threads, quiet);
+  if (!is_dealer_rank()) return {};
+  return outcomes;
 }
 
 void validate_pulse_options(const PulseOptions& opts) {

@@ -58,6 +58,7 @@
 // not depend on the thread count.
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -170,15 +171,67 @@ struct AmplitudeSearchOptions {
   double tolerance = 0.02;  // relative bracket width of the final bisection, in (0, 1)
 };
 
+// What tells a search's runs apart in a journal beyond their frequency and amplitude: `fields`
+// (an IDA's record: {"record": file, "record_hash": h}) are written into each run's record and
+// must match when resuming; `label` names the search in the progress lines (empty:
+// "f = 2.000 Hz").
+struct SearchKey {
+  nlohmann::json fields = nlohmann::json::object();
+  std::string label;
+};
+
+// Whether a journal record `run` belongs to the search of `frequency` and `key`.
+bool same_search(const nlohmann::json& run, double frequency, const SearchKey& key);
+
 // The collapse amplitude at one frequency (header comment). With a `journal`
-// (drivers/journal.hpp; `pulse --curve --resume FILE`), a run of the same frequency and
-// amplitude found there is taken from it instead of being run (the searches recompute the same
-// amplitudes bit for bit), and every run is appended as it finishes; safe to share between the
-// frequencies run in parallel.
+// (drivers/journal.hpp; `pulse --curve --resume FILE`), a run of the same search (same_search)
+// and amplitude found there is taken from it instead of being run (the searches recompute the
+// same amplitudes bit for bit), and every run is appended as it finishes; safe to share between
+// the searches run in parallel.
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
                                    double frequency, const AmplitudeSearchOptions& search,
                                    const PulseCriteria& criteria, bool quiet,
-                                   Journal* journal = nullptr);
+                                   Journal* journal = nullptr, const SearchKey& key = {});
+
+// The tilting capacity lambda* that a study of base motions starts its searches from (and
+// compares them with): `given` when it is >= 0 (--lambda-star), otherwise `voussoir capacity`'s
+// search (drivers/capacity.hpp, `points` trials a round, journalled in `resume` + ".capacity"
+// when `resume` is not empty), run on rank 0 alone, its result shared with the other ranks.
+// Rank 0 rethrows a failure, and a search without a collapse is one (RunError: no quasi-static
+// limit; --lambda-star gives one); the other ranks then get nothing and stop without a word
+// (rank 0 reports it).
+struct TiltingCapacity {
+  double lambda_star = 0.0;
+  double wall_s = 0.0;  // of the search (0 when given)
+  bool computed = false;
+};
+std::optional<TiltingCapacity> study_capacity(const Config& config, const TrialCriteria& settle,
+                                              double given, int points, const std::string& resume,
+                                              bool quiet);
+
+// One search of a study: a failure curve's frequency, or an IDA's record (drivers/ida.hpp).
+struct SearchCell {
+  BaseConfig base;
+  double frequency = 0.0;  // [Hz] (0 for a record)
+  AmplitudeSearchOptions search;
+  SearchKey key;
+};
+struct SearchOutcome {
+  CurvePoint point;
+  std::string error;  // what went wrong in the search ("" when nothing did)
+};
+
+// Runs the searches `cells`, taken in the order `order` (the costliest first, for the dynamic
+// schedule; the order changes no result), dealt to `threads` threads per rank and to the ranks
+// of an MPI run (drivers/dealer.hpp), from copies of `settled`. With a `journal` (rank 0's;
+// null: none) every run is journalled: in one process as it finishes; under mpirun a search
+// takes its runs already journalled with it, and rank 0 journals its new runs when the search
+// comes back. Returns on rank 0 the outcome of each cell (by cell index), `done` being told of
+// each as it arrives (progress); an empty vector on the other ranks.
+std::vector<SearchOutcome> deal_searches(
+    const SettledState& settled, const std::vector<SearchCell>& cells,
+    const std::vector<std::size_t>& order, const PulseCriteria& criteria, int threads, bool quiet,
+    Journal* journal, const std::function<void(std::size_t, const SearchOutcome&)>& done);
 
 // The journal of a curve's runs: its fingerprint (the settled state, the signal's definition
 // and the classification criteria: what a run at (frequency, amplitude) depends on), and a run
@@ -216,10 +269,10 @@ struct PulseOptions {
   double free_time = 1.5;       // --free-time S: PulseCriteria::free_time [s]
   double tilt_reference = 0.0;  // --tilt-reference X: a measured tilting capacity to compare
   bool tilt_reference_given = false;
-  std::string resume;           // --resume FILE: journal of the curve's runs (and FILE.capacity)
-  std::string spectrum;         // --spectrum FILE.csv: response spectrum of the base signal
-  std::string spectrum_plot;    // --spectrum-plot FILE.png (scripts/plot_spectrum)
-  bool spectrum_only = false;   // --spectrum-only: write the spectrum, run nothing
+  std::string resume;          // --resume FILE: journal of the curve's runs (and FILE.capacity)
+  std::string spectrum;        // --spectrum FILE.csv: response spectrum of the base signal
+  std::string spectrum_plot;   // --spectrum-plot FILE.png (scripts/plot_spectrum)
+  bool spectrum_only = false;  // --spectrum-only: write the spectrum, run nothing
 };
 
 // Checks the options (the curve's search and frequencies with --curve): DeckError (exit 2)

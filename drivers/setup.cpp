@@ -91,8 +91,9 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   if (!(dt_stable >= kMinStableStep)) {
     std::ostringstream msg;
     msg << config.deck_path << ": the stable time step of this model is " << dt_stable
-        << " s (at least " << kMinStableStep << " s needed): the material (young = "
-        << config.material.young << " Pa, density = " << config.material.density
+        << " s (at least " << kMinStableStep
+        << " s needed): the material (young = " << config.material.young
+        << " Pa, density = " << config.material.density
         << " kg/m3), solver.damping_factor = " << config.solver.damping_factor
         << ", the mesh or the contact penalty (" << cp.penalty << " Pa) are out of range";
     throw DeckError(msg.str());

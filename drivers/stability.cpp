@@ -42,8 +42,8 @@ double stability_ke_length(const Config& config, const Model& model) {
   return hi > lo ? hi - lo : 1.0;
 }
 
-StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& crit,
-                                 bool keep_mode, const std::string& cell_label) {
+StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& crit, bool keep_mode,
+                                 const std::string& cell_label) {
   const auto t0 = Clock::now();
   Config config = deck;
   config.load.lambda = 0.0;  // gravity only
@@ -223,9 +223,9 @@ StabilityCell stability_cell_from_record(const nlohmann::json& j) {
   return r;
 }
 
-std::vector<StabilityCell> run_stability_map(const Grid& grid,
-                                             const StabilityCriteria& crit, int threads,
-                                             bool keep_modes, bool quiet, Journal* journal) {
+std::vector<StabilityCell> run_stability_map(const Grid& grid, const StabilityCriteria& crit,
+                                             int threads, bool keep_modes, bool quiet,
+                                             Journal* journal) {
   const size_t cells = grid.configs.size();
   const bool dealer = is_dealer_rank();
   // Limit-analysis cross-checks first, serially (a few ms each; GLPK is not assumed to be
@@ -238,8 +238,8 @@ std::vector<StabilityCell> run_stability_map(const Grid& grid,
   std::vector<StabilityCell> out(cells);
   auto take_record = [&](size_t c, const nlohmann::json& j) {
     if (c >= cells || j.at("values") != nlohmann::json(grid.values[c]))
-      throw RunError("the stability journal belongs to another grid (cell " +
-                     std::to_string(c) + ")");
+      throw RunError("the stability journal belongs to another grid (cell " + std::to_string(c) +
+                     ")");
     out[c] = stability_cell_from_record(j);
     out[c].la_admissible = la[c].la_admissible;
     out[c].la_status = la[c].la_status;

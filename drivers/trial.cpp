@@ -70,8 +70,7 @@ class FiniteGuard : public StopRule {
 
 class EnergyGuard : public StopRule {
  public:
-  EnergyGuard(const RunLimits& limits, const std::string& label)
-      : limits_(limits), label_(label) {}
+  EnergyGuard(const RunLimits& limits, const std::string& label) : limits_(limits), label_(label) {}
   std::optional<Verdict> check(const Probe& p) override {
     if (limits_.drift_limit > 0.0 && p.sim.step >= limits_.drift_arm_steps)
       check_energy_balance(p.sim, limits_.drift_limit, label_);

@@ -3,7 +3,8 @@
 twice, labelled `mpi`, where the program is built with MPI:
 
   --part same     a 12-cell sweep (cases/block.toml, friction x width), a 16-cell corner of the
-                  Gilbert stability map and a 4-frequency pulse curve, each run in one process
+                  Gilbert stability map, a 4-frequency pulse curve and an IDA of a slender block
+                  under 3 records, each run in one process
                   (2 threads) and under mpirun -n 2 (1 thread a rank): the same CSV byte for
                   byte once the wall_s column is removed; the JSON says how many ranks ran. The
                   map once more with a step budget that 6 cells exceed: the same failed rows,
@@ -19,6 +20,7 @@ Usage: tests/python/mpi_ranks.py --bin build/voussoir --mpirun mpirun --work DIR
 import argparse
 import csv
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -39,6 +41,32 @@ STABILITY = ["stability", os.path.join(SOURCE, "cases", "gilbert_arch.toml"),
 CURVE = ["pulse", os.path.join(SOURCE, "cases", "block.toml"), "--set", "mesh.size=0.5",
          "--set", "material.young=1e9", "--set", 'load.base.signal="windowed_sine"', "--curve",
          "--freqs", "2,3,4,5", "--lambda-star", "0.5", "--search", "bisect"]
+
+
+IDA = ["ida", os.path.join(SOURCE, "cases", "block.toml"), "--set", "model.width=0.2",
+       "--set", 'material.model="rigid"', "--set", "contact.normal_stiffness=1e10",
+       "--set", "contact.shear_stiffness=1e10", "--lambda-star", "0.2"]
+
+
+def write_records(work):
+    """Three 6 s two-column records (sums of sinusoids under an envelope, peak 0.3 g), as in
+    tests/unit/test_ida.cpp; returns their paths joined by commas."""
+    paths = []
+    for k in range(3):
+        freqs = (0.9, 1.7, 2.6, 3.3, 4.4, 5.8)
+        a = []
+        for i in range(601):
+            t = 0.01 * i
+            v = sum(math.sin(2 * math.pi * f * t + 1.3 * (k + 1) * (j + 1)) / math.sqrt(f)
+                    for j, f in enumerate(freqs))
+            a.append(v * min(1.0, t * t) * (math.exp(-1.5 * (t - 4.0)) if t > 4.0 else 1.0))
+        peak = max(abs(v) for v in a)
+        path = os.path.join(work, f"rec{k}.txt")
+        with open(path, "w") as f:
+            for i, v in enumerate(a):
+                f.write(f"{0.01 * i:.2f}, {0.3 * v / peak:.9e}\n")
+        paths.append(path)
+    return ",".join(paths)
 
 
 def run(cmd):
@@ -74,8 +102,9 @@ def same(a):
     # --max-time; the collapsed ones stop at --ke-time): failed cells, reported in their rows
     # while the others run, exit status 1, in one process as under mpirun.
     failing = STABILITY + ["--max-steps", "20000"]
+    ida = IDA + ["--records", write_records(a.work)]
     for name, args, expect_rc in (("sweep", SWEEP, 0), ("stability", STABILITY, 0),
-                                  ("curve", CURVE, 0), ("failing", failing, 1)):
+                                  ("curve", CURVE, 0), ("ida", ida, 0), ("failing", failing, 1)):
         one, (rc1, _, err1) = study(a, name, args, 1)
         two, (rc2, out2, err2) = study(a, name, args, 2)
         check(rc1 == expect_rc, f"{name} in one process: exit {rc1}\n{err1[-2000:]}")
@@ -85,12 +114,16 @@ def same(a):
         r1, r2 = rows_without_wall(one + ".csv"), rows_without_wall(two + ".csv")
         check(len(r1) > 1, f"{name}: the one-process CSV has no rows")
         check(r1 == r2, f"{name}: the CSVs differ (wall_s aside):\n{r1}\n{r2}")
+        if name == "ida":
+            runs1, runs2 = rows_without_wall(one + "_runs.csv"), rows_without_wall(two + "_runs.csv")
+            check(len(runs1) > 3 and runs1 == runs2,
+                  f"ida: the runs CSVs differ (wall_s aside):\n{runs1}\n{runs2}")
         j1, j2 = json.load(open(one + ".json")), json.load(open(two + ".json"))
         check(j1.get("ranks") == 1 and j2.get("ranks") == 2,
               f"{name}: JSON ranks {j1.get('ranks')} and {j2.get('ranks')}, expected 1 and 2")
         check("2 ranks" in err2, f"{name}: no dealing line on stderr:\n{err2[-2000:]}")
         # Rank 0 alone prints: one summary line.
-        check(out2.count(" written to ") + out2.count("; curve ") == 1,
+        check(out2.count(" written to ") + out2.count("; curve ") + out2.count(", runs ") == 1,
               f"{name}: stdout under mpirun is not one rank's:\n{out2}")
     with open(os.path.join(a.work, "failing_2.csv"), newline="") as f:
         reasons = [(r["reason"], r["error"] != "") for r in csv.DictReader(f)]
