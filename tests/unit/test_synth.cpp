@@ -19,6 +19,7 @@
 #include "core/spectrum.hpp"
 #include "core/synth.hpp"
 #include "io/accelerogram.hpp"
+#include "subprocess.hpp"
 
 namespace voussoir {
 namespace {
@@ -195,6 +196,68 @@ TEST(SynthAt2, WriteThenReadRoundTrips) {
   write_at2(path, a, 0.01, "t", "n");
   const Accelerogram file = read_accelerogram(path, "g", 1.0);
   EXPECT_EQ(file.accel, parse_at2(text, "mem.AT2", 1.0).accel);
+  std::filesystem::remove_all(temp_dir());
+}
+
+testing::ProcessResult run_synth(std::vector<std::string> extra) {
+  std::vector<std::string> args = {VOUSSOIR_BINARY, "synth"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  testing::Limits limits;
+  limits.wall_s = 60;
+  std::filesystem::create_directories(temp_dir());
+  return testing::run_process(args, limits, (temp_dir() / "child").string());
+}
+
+// The command: two records written and read back, the CSV's columns, the JSON; each bad option
+// refused with exit status 2 and a message naming the option and its value.
+TEST(SynthCommand, WritesRecordsAndRefusesBadOptions) {
+  const std::string out = (temp_dir() / "out").string();
+  const std::string json = (temp_dir() / "synth.json").string();
+  testing::ProcessResult r = run_synth({"--ag", "0.2", "--soil", "c", "--count", "2", "--seed", "3",
+                                        "-o", out, "--no-plot", "--json", json});
+  ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
+  EXPECT_NE(r.out.find("mean PGA >= ag S: met"), std::string::npos) << r.out;
+  const Accelerogram rec = read_accelerogram(out + "/synth_02.AT2", "g", 1.0);
+  EXPECT_EQ(rec.accel.size(), 2001u);
+  EXPECT_EQ(rec.time[1], 0.01);
+  std::ifstream csv(out + "/spectra.csv");
+  std::string head;
+  std::getline(csv, head);
+  EXPECT_EQ(head, "period,target,synth_01,synth_02,mean");
+  int rows = 0;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  EXPECT_EQ(rows, 102);  // 100 log-spaced periods and the range's two ends
+  EXPECT_TRUE(std::filesystem::exists(json));
+  EXPECT_NE(testing::read_text_file(json).find("\"ec8_mean_pga_ok\": true"), std::string::npos);
+
+  struct Bad {
+    std::vector<std::string> args;
+    std::string names;  // the option and value the message must name
+  };
+  const std::vector<Bad> bad = {
+      {{"--ag", "0.25", "--count", "0"}, "--count 0"},
+      {{"--ag", "0"}, "--ag 0"},
+      {{"--ag", "-0.1"}, "--ag -0.1"},
+      {{"--ag", "nan"}, "--ag nan"},
+      {{"--ag", "9.81"}, "--ag 9.81"},
+      {{"--ag", "0.25", "--soil", "F"}, "--soil F"},
+      {{"--ag", "0.25", "--spectrum", "asce"}, "--spectrum asce"},
+      {{"--ag", "0.25", "--duration", "4"}, "--duration 4"},
+      {{"--ag", "0.25", "--dt", "0"}, "--dt 0"},
+      {{"--ag", "0.25", "--dt", "-0.01"}, "--dt -0.01"},
+      {{"--ag", "0.25", "--dt", "0.02"}, "--dt 0.02"},
+      {{"--ag", "0.25", "--seed", "-1"}, "--seed -1"},
+      {{"--ag", "0.25", "--range", "3,0.05"}, "--range 3,0.05"},
+      {{"--count", "3"}, "--ag"},  // --ag is required
+  };
+  for (const Bad& b : bad) {
+    std::vector<std::string> args = b.args;
+    args.insert(args.end(), {"-o", (temp_dir() / "bad").string(), "--no-plot"});
+    r = run_synth(args);
+    EXPECT_TRUE(r.exited && r.status == 2) << b.names << ": " << r.describe();
+    EXPECT_NE(r.err.find(b.names), std::string::npos) << b.names << ": " << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "bad"));  // refused before writing
   std::filesystem::remove_all(temp_dir());
 }
 
