@@ -20,6 +20,7 @@
 #include "drivers/setup.hpp"
 #include "drivers/spread.hpp"
 #include "drivers/stability.hpp"
+#include "drivers/synth_command.hpp"
 #include "io/deck.hpp"
 #include "io/deck_reference.hpp"
 #include "voussoir/config.hpp"
@@ -338,6 +339,38 @@ int main(int argc, char** argv) {
   stability->add_option("--max-time", stab_opts.max_time,
                         "simulated time after which undecided cells are decided [s] (default 3)");
 
+  voussoir::SynthOptions synth_opts;
+  CLI::App* synth = app.add_subcommand(
+      "synth",
+      "artificial accelerograms compatible with the EN 1998-1 elastic spectrum (AT2 "
+      "records, their spectra; docs/records.md)");
+  synth->add_option("--spectrum", synth_opts.spectrum, "target spectrum: ec8 (EN 1998-1 Type 1)")
+      ->capture_default_str();
+  synth->add_option("--ag", synth_opts.ag, "design ground acceleration on type A ground [g]")
+      ->required();
+  synth->add_option("--soil", synth_opts.soil, "ground type A, B, C, D or E (EN 1998-1 Table 3.2)")
+      ->capture_default_str();
+  synth->add_option("--count", synth_opts.count, "number of records")->capture_default_str();
+  synth->add_option("--duration", synth_opts.duration, "length of each record [s]")
+      ->capture_default_str();
+  synth->add_option("--dt", synth_opts.dt, "time step of the records [s]")->capture_default_str();
+  synth->add_option("--seed", synth_opts.seed, "seed of the random phases (>= 0)")
+      ->capture_default_str();
+  synth
+      ->add_option("--range", synth_opts.range,
+                   "TMIN,TMAX: periods [s] where the mean spectrum is checked against 90% of the "
+                   "target (default 0.05,3)")
+      ->delimiter(',')
+      ->expected(2);
+  synth->add_option("-o,--output", synth_opts.output, "output folder")->capture_default_str();
+  synth->add_option("--plot", synth_opts.plot,
+                    "PNG of the spectra and the first record (default DIR/spectra.png; "
+                    "scripts/plot_synth)");
+  synth->add_flag("--no-plot", synth_opts.no_plot, "no plot");
+  synth->add_option("--json", synth_opts.json, "write a JSON summary to FILE ('-' for stdout)");
+  synth->add_option("--threads", synth_opts.threads, "OpenMP threads (records in parallel)")
+      ->check(CLI::Range(1, 1024));
+
   CLI::App* keys =
       app.add_subcommand("keys",
                          "print the deck reference: every key, type, unit, default, allowed values "
@@ -360,6 +393,7 @@ int main(int argc, char** argv) {
       std::fputs(voussoir::deck_reference_markdown().c_str(), stdout);
       return 0;
     }
+    if (synth->parsed()) return voussoir::command_synth(synth_opts);
     if (common.threads > 0) omp_set_num_threads(common.threads);
     if (sweep->parsed()) return voussoir::command_sweep(deck.deck, deck.sets, common, sweep_opts);
     if (stability->parsed())

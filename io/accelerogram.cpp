@@ -6,9 +6,13 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
+
+#include "io/json.hpp"
 
 namespace voussoir {
 
@@ -201,6 +205,42 @@ Accelerogram read_accelerogram(const std::string& path, const std::string& units
     return parse_at2(text.str(), path, gravity);
   }
   return parse_accelerogram(text.str(), path, units, gravity);
+}
+
+std::string format_at2(const std::vector<double>& accel_g, double dt, const std::string& title,
+                       const std::string& note) {
+  auto one_line = [](std::string s) {
+    std::replace(s.begin(), s.end(), '\n', ' ');
+    std::replace(s.begin(), s.end(), '\r', ' ');
+    return s;
+  };
+  // DT in the fewest significant digits that strtod reads back to the same double.
+  char dt_text[40] = "";
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(dt_text, sizeof dt_text, "%.*g", digits, dt);
+    if (std::strtod(dt_text, nullptr) == dt) break;
+  }
+  std::string text =
+      one_line(title) + "\n" + one_line(note) +
+      "\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS= " + std::to_string(accel_g.size()) +
+      ", DT= " + dt_text + " SEC\n";
+  text.reserve(text.size() + 18 * accel_g.size());
+  char value[40];
+  for (std::size_t k = 0; k < accel_g.size(); ++k) {
+    std::snprintf(value, sizeof value, " %16.9E", accel_g[k] + 0.0);  // -0 written as 0
+    text += value;
+    if (k % 5 == 4 || k + 1 == accel_g.size()) text += '\n';
+  }
+  return text;
+}
+
+void write_at2(const std::string& path, const std::vector<double>& accel_g, double dt,
+               const std::string& title, const std::string& note) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw OutputError(path + ": cannot write the AT2 record: " + std::strerror(errno));
+  out << format_at2(accel_g, dt, title, note);
+  out.close();
+  if (!out) throw OutputError(path + ": cannot write the AT2 record: write failed");
 }
 
 int baseline_degree(const std::string& baseline) {

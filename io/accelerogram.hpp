@@ -12,9 +12,11 @@
 //               `5590    0.0050    NPTS, DT` (older NGA); then NPTS accelerations in g, any
 //               count per line, Fortran numbers (`.1234E-02`, `-1.234D-03`); sample k at k DT.
 // A file is read as AT2 when its name ends in .AT2 (any case) or its 4th line names NPTS and
-// DT (looks_like_at2); anything else by the two-column reader, unchanged.
+// DT (looks_like_at2); anything else by the two-column reader, unchanged. write_at2 writes the
+// NGA-West2 form (`voussoir synth`).
 
 #include <string>
+#include <vector>
 
 #include "core/base_motion.hpp"
 #include "core/schema.hpp"
@@ -42,6 +44,19 @@ bool looks_like_at2(const std::string& path, const std::string& text);
 // Reads and parses the file, as AT2 when looks_like_at2 says so (then `units` must be "g":
 // AT2 values are in g), two-column otherwise. DeckError if it cannot be read.
 Accelerogram read_accelerogram(const std::string& path, const std::string& units, double gravity);
+
+// The text of a PEER AT2 record (NGA-West2 header) that parse_at2 reads back: line 1 `title`,
+// line 2 `note` (line breaks in either become spaces), line 3 "ACCELERATION TIME SERIES IN
+// UNITS OF G", line 4 "NPTS= N, DT= D SEC" with D written in the fewest digits that read back
+// to the same double; then the N values of `accel_g` [g] (sample k at t = k dt [s]) as
+// " %16.9E", five a line: 10 significant digits, a relative rounding of at most 5e-10, and a
+// value read back from such a file is written again to the same text.
+std::string format_at2(const std::vector<double>& accel_g, double dt, const std::string& title,
+                       const std::string& note);
+
+// Writes format_at2 to `path`; OutputError (io/json.hpp) naming the path if it cannot.
+void write_at2(const std::string& path, const std::vector<double>& accel_g, double dt,
+               const std::string& title, const std::string& note);
 
 // Baseline correction (deck load.base.baseline; docs/records.md). A record with an offset or
 // a slow drift in its acceleration (instrument tilt, a shifted zero) integrates to a table
