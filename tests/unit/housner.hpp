@@ -10,7 +10,7 @@
 // (I_o = 4/3 m R^2 about the corner), under a horizontal ground acceleration a_g(t):
 //     theta'' = -p^2 [ sin(alpha sgn(theta) - theta) + (a_g / g) cos(alpha sgn(theta) - theta) ]
 // (Housner 1963; Makris & Zhang 2001, eq. 1, with the same signs: a_g > 0 tips the block to
-// theta < 0, the inertial force -m a_g pointing to -x; DeJong 2012). At rest the block starts
+// theta < 0, the inertial force -m a_g pointing to -x). At rest the block starts
 // to rock when |a_g| > g tan(alpha), to the side s = -sgn(a_g), from theta = 0, theta' = 0.
 // Each impact (theta crossing 0) changes the pivot; angular momentum about the new corner is
 // kept, which multiplies theta' by Housner's
@@ -51,6 +51,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <numbers>
