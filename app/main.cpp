@@ -374,7 +374,7 @@ int main(int argc, char** argv) {
   CLI::App* keys =
       app.add_subcommand("keys",
                          "print the deck reference: every key, type, unit, default, allowed values "
-                         "(docs/deck.md)");
+                         "(docs/reference/deck.md)");
 
   try {
     app.parse(argc, argv);

@@ -225,7 +225,7 @@ ElementStageResult element_threads(Model& model, const CstLaw& law, double* visc
 }
 
 // Specialised on the features in use: viscous term (eta > 0) and ledger buffer, so an
-// undamped run pays for neither (docs/benchmarks.md "Specialisation").
+// undamped run pays for neither (measured with bench/bench_elements).
 template <bool kViscous, bool kDamped>
 ElementStageResult element_stage(Model& model, const CstLaw& law, double* viscous,
                                  ElementWorkspace* work) {

@@ -88,7 +88,7 @@ void finalize_model(Model& model) {
   // An edge is on the block boundary when no other triangle shares it (nodes belong to one
   // block, so a sharing triangle is of the same block). Sorted edge keys rather than a
   // std::map: a map node per edge (~64 B x 1.5 edges per triangle) stayed in the resident
-  // set after being freed (docs/benchmarks.md "Memory per triangle").
+  // set after being freed (docs/performance.md, memory per triangle).
   auto key = [](Index a, Index b) {
     const auto lo = std::uint64_t(std::uint32_t(std::min(a, b)));
     const auto hi = std::uint64_t(std::uint32_t(std::max(a, b)));

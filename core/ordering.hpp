@@ -9,7 +9,8 @@
 // triangle ranges (Block::first_node, ...), triangles keep their corner order (orientation).
 // METIS runs serially with a fixed seed: the order is a function of the mesh only.
 //
-// Measured effect and why it is not called by the scenes: docs/benchmarks.md "METIS ordering".
+// Measured effect and why it is not called by the scenes: docs/benchmarks.md, "Measured and
+// not used".
 
 #include <vector>
 

@@ -45,8 +45,8 @@ namespace voussoir {
 // run stopped by the 5% guard (docs/rigid.md, "The stable step of rigid blocks"). So 0.4:
 // omega dt = 0.72, about nine steps per period of the stiffest joint mode.
 inline constexpr double kRigidStepFraction = 0.4;
-// The quasi-static settle and trials of `capacity` and `sweep` take the same fraction. From
-// session 16 to 19 they took 0.5 (omega dt = 0.9), and that froze trials: the bound omega is
+// The quasi-static settle and trials of `capacity` and `sweep` take the same fraction. Rejected:
+// 0.5 (omega dt = 0.9) there, which froze trials: the bound omega is
 // per body, the joints couple the bodies into modes faster than it (about 1.3 times on the
 // buttressed basket arch), and at 0.5 such a mode turns within one step (omega dt > 1). The
 // kinetic damping then resets the velocities at every second step, and a structure that is

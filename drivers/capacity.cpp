@@ -446,7 +446,7 @@ TrialResult trial_from_json(const nlohmann::json& j) {
   r.max_displacement = j.at("max_displacement");
   r.max_rotation = j.at("max_rotation");
   r.energy_balance_error = j.at("energy_balance_error");
-  r.kinetic_resets = j.value("kinetic_resets", 0LL);  // journals before session 20 have none
+  r.kinetic_resets = j.value("kinetic_resets", 0LL);  // older journals have none
   r.hinges = hinges_from_record(j.at("hinges"));
   return r;
 }

@@ -245,7 +245,7 @@ struct CapacitySearch {
 // lies between 0.981 (the churches) and 1.000 (the blocks) on the 22 regression cases
 // (docs/regression.md), 0.992 on the semicircular arch. Replayed on those searches' trials,
 // 0.99 guesses the next round wrong 4 times in 44, the bracket's middle 33 times
-// (scripts/ahead_guess; docs/benchmarks.md, "Session 16").
+// (scripts/ahead_guess).
 inline constexpr double kAheadGuess = 0.99;
 inline constexpr double kSeedLow = 0.92;   // FDEM lambda* lies a few % below the rigid LA one
 inline constexpr double kSeedHigh = 1.02;  // (deformable blocks, non-associative friction)

@@ -167,7 +167,7 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 // The reader: knows where the current value came from and turns every refusal into one line.
 
 // What a key's reader allows, found by handing it a value no reader accepts (a table) in
-// probing mode: the deck reference (io/deck_reference.cpp, `voussoir keys`, docs/deck.md)
+// probing mode: the deck reference (io/deck_reference.cpp, `voussoir keys`, docs/reference/deck.md)
 // is thus the reader's own rule, never a copy of it.
 struct KeyProbe {
   std::string type, unit, allowed;

@@ -1,6 +1,6 @@
 #pragma once
-// The deck reference for users (docs/deck.md, printed by `voussoir keys`): every key the deck
-// reader accepts with its type, unit, default, allowed values and one line of meaning.
+// The deck reference for users (docs/reference/deck.md, printed by `voussoir keys`): every key
+// the deck reader accepts with its type, unit, default, allowed values and one line of meaning.
 //
 // Where each column comes from, so the reference cannot drift from the code:
 //   - the keys, types, units and allowed values: the deck reader itself (io/deck.hpp
@@ -9,7 +9,7 @@
 //   - which kinds need a key: the scene-kind registry (core/scene_kinds.hpp);
 //   - the meaning: one line per key in io/deck_reference.cpp, the only hand-written column.
 // The DeckReference tests (tests/unit/test_tools.cpp) fail naming any key the reader accepts
-// without a line there, and when docs/deck.md differs from `voussoir keys`.
+// without a line there, and when docs/reference/deck.md differs from `voussoir keys`.
 
 #include <string>
 #include <vector>
@@ -32,7 +32,7 @@ std::vector<KeyReference> deck_reference();
 // accept (a key renamed or removed in the reader and not here).
 std::vector<std::string> stale_reference_keys();
 
-// docs/deck.md: the reference as Markdown, one table per section.
+// docs/reference/deck.md: the reference as Markdown, one table per section.
 std::string deck_reference_markdown();
 
 }  // namespace voussoir

@@ -29,7 +29,7 @@ constexpr double kMaxTriangles = 4e6;
 // the triangle budget (5 area / size^2), plus a floor for small blocks: a quality mesh grows far
 // beyond its area's share only where the outline is much thinner than the element size (a
 // sliver, a needle corner, a narrow slot), and there it may not stop (docs/robustness.md, "Open
-// findings", session 19). The largest polygon block of a shipped deck uses 8% of its cap.
+// findings"). The largest polygon block of a shipped deck uses 8% of its cap.
 constexpr double kPolygonMeshSlack = 10.0;
 constexpr double kPolygonMeshFloor = 1e4;
 

@@ -79,8 +79,8 @@ std::string trim(const std::string& s) {
 
 // A corner sharper than this, or a notch narrower (interior angle above 360 degrees minus it),
 // is refused: near it the two edges run closer than any element size for a long way, and the
-// constrained triangulation of the refined outline grows without bound there (slow fuzz tier,
-// session 19: a vertex moved to x = 65536 made a 4e-6 rad needle that kept `check` busy for
+// constrained triangulation of the refined outline grows without bound there (slow fuzz tier:
+// a vertex moved to x = 65536 made a 4e-6 rad needle that kept `check` busy for
 // minutes). Drawn masonry has no such corners; a stray or mistyped vertex does.
 constexpr double kMinCornerDeg = 1.0;
 

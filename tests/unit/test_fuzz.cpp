@@ -161,7 +161,7 @@ TEST(FuzzFindings, ChurchHugeOuterWidth) {
 }
 
 // mesh/scenes_church.cpp: supports of 5e-324 m (or 1e-6 m) were outlined into ever more course
-// slivers and `check` never finished (slow fuzz tier, session 2).
+// slivers and `check` never finished (slow fuzz tier).
 TEST(FuzzFindings, ChurchTinyHeight) {
   for (const std::string& set : {std::string("model.height=5e-324"), std::string("model.height=1e-6")}) {
     expect_refused_naming(check_with("church_a.toml", {set}),
@@ -172,7 +172,7 @@ TEST(FuzzFindings, ChurchTinyHeight) {
 }
 
 // drivers/setup.cpp: a damping factor of 9e18 made a stable step of 1.9e-25 s, refused only by
-// the run loop (exit 1) after set-up (slow fuzz tier, session 2). Now refused up front.
+// the run loop (exit 1) after set-up (slow fuzz tier). Now refused up front.
 TEST(FuzzFindings, AbsurdDampingTimeStep) {
   expect_refused_naming(
       check_with("church_a.toml",  // elastic: the element damping sets no step for rigid blocks
@@ -181,7 +181,7 @@ TEST(FuzzFindings, AbsurdDampingTimeStep) {
 }
 
 // mesh/scenes_polygons.cpp: block 0 = (-0.25, 0), (0.25, 0), (0.25, 2147483648), (-1.75, -0.25),
-// a 2e9 m tall sliver reaching into the ground -> std::bad_alloc (exit 1). Since session 19 its
+// a 2e9 m tall sliver reaching into the ground -> std::bad_alloc (exit 1). Now its
 // 5e-8 degree corner is refused where the file is read; a 2e9 m tall column with square corners
 // still meets the triangle estimate.
 TEST(FuzzFindings, PolygonHugeCoordinate) {
@@ -199,8 +199,8 @@ TEST(FuzzFindings, PolygonHugeCoordinate) {
 // mesh/scenes_polygons.cpp: tests/data/two_blocks.txt with block 0's first vertex moved to
 // (65536, 0) and one vertex gone: a needle 65 km long with a 4e-6 rad tip, still a simple
 // polygon. `check` first spent minutes in the O(n^2) simplicity test of the refined outline,
-// then (with a sweep there) in the constrained triangulation of the needle (slow fuzz tier,
-// sessions 2 to 18). With the tip at x = 1024 to 16384 the inexact simplicity test called the
+// then (with a sweep there) in the constrained triangulation of the needle (slow fuzz
+// tier). With the tip at x = 1024 to 16384 the inexact simplicity test called the
 // refined outline "not simple". Now the corner is refused where it is read, naming its line.
 TEST(FuzzFindings, PolygonNeedleCorner) {
   for (const std::string tip : {"1024", "65536"}) {

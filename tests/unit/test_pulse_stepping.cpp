@@ -24,7 +24,7 @@
 // collapse; the single bisection
 // started inside the band jumps over the mode-2 collapses and lands on A_1 (within 5%: joint
 // compliance, kn = 1e10 N/m3). And exit status 2 for a start, step or frequency that is zero or
-// negative. Measured (session 9, the dashpot on the nodal forces' rates): stepping A_c =
+// negative. Measured (the dashpot on the nodal forces' rates): stepping A_c =
 // 1.665 g (ODE interval [1.45, 1.86]), survived at 2.798 and 3.022 g (the ODE survives 2.798 g
 // at r <= 0.92 and 3.022 g at r <= 0.96; r_H = 0.942); about 2 s in all.
 

@@ -4,7 +4,7 @@
 //   - `check` refuses a model with no free block or a `fixed` index outside the blocks,
 //     naming model.fixed (exit 2);
 //   - `capacity` with no collapse says "no collapse up to lambda_max" and gives no lambda*;
-//   - docs/deck.md is `voussoir keys`, and every key the reader accepts has its line.
+//   - docs/reference/deck.md is `voussoir keys`, and every key the reader accepts has its line.
 
 #include <gtest/gtest.h>
 
@@ -208,7 +208,7 @@ TEST(DeckReference, EveryKeyHasAMeaning) {
     EXPECT_FALSE(k.meaning.empty())
         << "deck key " << k.key
         << " has no line of meaning in io/deck_reference.cpp (meanings()); add it and "
-           "regenerate docs/deck.md with build/voussoir keys > docs/deck.md";
+           "regenerate docs/reference/deck.md with build/voussoir keys > docs/reference/deck.md";
     EXPECT_FALSE(k.default_value.empty())
         << "deck key " << k.key << " has no default in io/deck_reference.cpp (default_of())";
     EXPECT_FALSE(k.type.empty()) << "deck key " << k.key << ": its reader names no type";
@@ -224,7 +224,7 @@ TEST(DeckReference, DocsMatchTheCode) {
   const ProcessResult r = voussoir_run({"keys"}, dir);
   ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
   EXPECT_EQ(r.out, voussoir::deck_reference_markdown());
-  const std::string docs = read_text(kSource + "/docs/deck.md");
+  const std::string docs = read_text(kSource + "/docs/reference/deck.md");
   // Name the keys whose row is missing or differs, then compare the whole file.
   std::istringstream lines(r.out);
   std::string section;
@@ -233,10 +233,11 @@ TEST(DeckReference, DocsMatchTheCode) {
     if (line.rfind("| `", 0) != 0) continue;
     const std::string key = section + "." + line.substr(3, line.find('`', 3) - 3);
     EXPECT_NE(docs.find(line + "\n"), std::string::npos)
-        << "docs/deck.md: the row of deck key " << key
-        << " is missing or stale; regenerate with build/voussoir keys > docs/deck.md";
+        << "docs/reference/deck.md: the row of deck key " << key
+        << " is missing or stale; regenerate with build/voussoir keys > docs/reference/deck.md";
   }
-  EXPECT_EQ(docs, r.out) << "docs/deck.md is stale: build/voussoir keys > docs/deck.md";
+  EXPECT_EQ(docs, r.out)
+      << "docs/reference/deck.md is stale: build/voussoir keys > docs/reference/deck.md";
 }
 
 }  // namespace
