@@ -55,7 +55,7 @@ bool is_finished(const CellWork& w, std::size_t c) {
   return c < w.finished.size() && w.finished[c];
 }
 
-// One process: the OpenMP loop over cells of before issue 19.
+// One process: an OpenMP loop over the cells.
 void deal_here(const CellWork& w, int threads) {
   const long n = static_cast<long>(w.cells);
   const int nthreads = static_cast<int>(

@@ -1,12 +1,12 @@
 #pragma once
 // Dealing independent cells to the threads of one process or to the ranks of an MPI run
-// (`voussoir sweep`, `stability` and `pulse --curve`; docs/mpi.md).
+// (`voussoir sweep`, `stability`, `pulse --curve` and `ida`; docs/mpi.md).
 //
 // A study is N independent cells (a sweep's or a map's grid cells, a curve's frequencies). The
 // command gives deal_cells() what one cell is (`run`: cell c -> its journal record) and what to
 // do with a finished one (`take`); the dealer decides where each cell runs:
 //   - one process (no mpirun, `mpirun -n 1`, or a build without MPI): the cells are an OpenMP
-//     loop with a dynamic schedule over `threads` threads, as before issue 19;
+//     loop with a dynamic schedule over `threads` threads;
 //   - `mpirun -n N` (N > 1): rank 0 deals. Its main thread answers the other ranks (a rank that
 //     finishes a cell sends its record and gets the next cell index, so uneven cells idle no
 //     one) and its other `threads` threads take cells themselves; every other rank runs its

@@ -47,7 +47,7 @@
 //           then bisection inside [A_{k-1}, A_k] until hi - lo <= tolerance x hi. Then
 //           `steps_above` further steps above A_k, A_k (1 + step)^j, look for amplitudes that
 //           survive above a collapsing one (reported, never used to move A_c).
-//   Bisect  (the search before issue 25): from A_0 = start (default lambda*) growing by
+//   Bisect  (the single bisection): from A_0 = start (default lambda*) growing by
 //           kBracketGrowth until a collapse (down by it if A_0 collapses), then bisection.
 //           Fewer runs, but a growth step can jump over a collapse band and report the upper
 //           threshold (tests/unit/test_pulse_stepping.cpp shows it on a slender block).

@@ -1,6 +1,6 @@
 #pragma once
 // `voussoir spread DECK`: a support moved step by step until the structure collapses
-// (issue 45's spreading study; docs/supports.md).
+// (the spreading study; docs/supports.md).
 //
 // Procedure. The deck's model is settled under gravity and its own [supports] moves are made
 // (drivers/capacity.hpp settle, quasi-static as `capacity` runs it). Then one fixed block (the
