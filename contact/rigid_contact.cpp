@@ -97,13 +97,16 @@ double width_squared_integral(const double* s, const double* h, int n) {
 // sin and cos of theta / 2. Blocks at rest or near it turn by 1e-9 to 1e-3 rad: below 0.02 rad
 // the Taylor series to x^9 (x = theta / 2; the next term is below 1e-17 relative) replaces the
 // library's calls, a tenth of a joint's cost each.
+// The coefficients are constants of the program (the build's -frounding-math, which CGAL asks
+// for, would otherwise divide them out at every call).
 inline void half_angle(double theta, double& s, double& c) {
+  constexpr double kS3 = -1.0 / 6, kS5 = 1.0 / 120, kS7 = -1.0 / 5040, kS9 = 1.0 / 362880;
+  constexpr double kC4 = 1.0 / 24, kC6 = -1.0 / 720, kC8 = 1.0 / 40320, kC10 = 1.0 / 3628800;
   const double x = 0.5 * theta;
   if (std::abs(x) < 0.01) {
     const double x2 = x * x;
-    s = x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))));
-    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 +
-                                 x2 * (-1.0 / 720 + x2 * (1.0 / 40320 - x2 * (1.0 / 3628800)))));
+    s = x * (1.0 + x2 * (kS3 + x2 * (kS5 + x2 * (kS7 + x2 * kS9))));
+    c = 1.0 + x2 * (-0.5 + x2 * (kC4 + x2 * (kC6 + x2 * (kC8 - x2 * kC10))));
   } else {
     s = std::sin(x);
     c = std::cos(x);
@@ -228,15 +231,10 @@ Clipped* clip_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, cons
   return v;
 }
 
-}  // namespace
-
-bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
-                    bool with_energy) {
-  return convex_overlap(p, nullptr, np, q, nullptr, nq, out, with_energy);
-}
-
-bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
-                    ConvexOverlap& out, bool with_energy, std::uint32_t inner) {
+// convex_overlap, inlined into the contact stage's pair loop.
+[[gnu::always_inline]] inline bool overlap_of(const Vec2* p, const Vec2* pu, int np, const Vec2* q,
+                                              const Vec2* qu, int nq, ConvexOverlap& out,
+                                              bool with_energy, std::uint32_t inner) {
   Clipped buf[2];
   Clipped* o = pu && qu ? clip_overlap<true>(p, pu, np, q, qu, nq, inner, buf)
                         : clip_overlap<false>(p, pu, np, q, qu, nq, inner, buf);
@@ -295,6 +293,18 @@ bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const 
   }
   out.depth_sq = width_squared_integral(s, h, n);
   return true;
+}
+
+}  // namespace
+
+bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
+                    bool with_energy) {
+  return convex_overlap(p, nullptr, np, q, nullptr, nq, out, with_energy);
+}
+
+bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
+                    ConvexOverlap& out, bool with_energy, std::uint32_t inner) {
+  return overlap_of(p, pu, np, q, qu, nq, out, with_energy, inner);
 }
 
 int separating_line(const Vec2* p, int np, const Vec2* q, int nq) {
@@ -478,6 +488,8 @@ void RigidContact::detect_at(const Model& model, const std::vector<double>& ux,
   inner_.resize(live_i_.size());
   for (std::size_t l = 0; l < live_i_.size(); ++l)
     inner_[l] = inner_lines(model, ux, uy, live_i_[l], live_j_[l]);
+  moves_.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) moves_[b] = has_pose(model, b);
   // The pieces the steps displace: those of the live pairs on bodies with a pose, in order.
   std::vector<char> live_piece(piece_block_.size(), 0);
   for (std::size_t l = 0; l < live_i_.size(); ++l)
@@ -582,6 +594,7 @@ std::uint32_t RigidContact::inner_lines(const Model& model, const std::vector<do
 void RigidContact::pair_constants(const Model& model) {
   const std::size_t np = pair_a_.size();
   kn_t_.resize(np), kt_.resize(np), beta_.resize(np);
+  pair_energy_.resize(np), pair_stored_.resize(np);
   for (std::size_t p = 0; p < np; ++p) {
     const Index a = pair_a_[p], b = pair_b_[p];
     const Block& ba = model.blocks[std::size_t(a)];
@@ -672,33 +685,37 @@ void RigidContact::displace_live_pieces(const Model& model) {
 }
 
 // Pair p at the current configuration: false when its blocks do not overlap (its history is
-// then dropped).
-bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool energy,
-                            PairOut& out) {
-  const RigidBodies& r = model.rigid;
+// then dropped). Inlined into the contact stage's pair loop.
+[[gnu::always_inline]] inline bool RigidContact::evaluate(std::size_t p, const BodyView& r,
+                                                          double dt, bool energy, PairOut& out) {
   const Index a = pair_a_[p], b = pair_b_[p];
+  const double kn_t = kn_t_[p];
+  const bool touched = touched_[p];
   double area = 0.0, energy2 = 0.0, gx = 0.0, gy = 0.0;
   Vec2 force, unit;  // unit: the one overlap's normal
   int regions = 0;
   double mb = 0.0, ma = 0.0;
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
-  Vec2 damp;                                  // the dashpots' force on b
-  double damp_mb = 0.0, damp_ma = 0.0;        // and their moments on b and on a
-  const double c_damp = beta_[p] * kn_t_[p];  // beta kn t_z [N s/m2]
+  Vec2 damp;                              // the dashpots' force on b
+  double damp_mb = 0.0, damp_ma = 0.0;    // and their moments on b and on a
+  const double c_damp = beta_[p] * kn_t;  // beta kn t_z [N s/m2]
+  const Index* first = piece_first_.data();
+  const Vec2* ref = ref_.data();
+  const Vec2* disp = disp_.data();
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
     const Index i = live_i_[live], j = live_j_[live];
-    const Vec2 *pv = &ref_[piece_first_[i]], *pu = &disp_[piece_first_[i]];
-    const Vec2 *qv = &ref_[piece_first_[j]], *qu = &disp_[piece_first_[j]];
-    const int np = piece_first_[i + 1] - piece_first_[i];
-    const int nq = piece_first_[j + 1] - piece_first_[j];
+    const Vec2 *pv = &ref[first[i]], *pu = &disp[first[i]];
+    const Vec2 *qv = &ref[first[j]], *qu = &disp[first[j]];
+    const int np = first[i + 1] - first[i];
+    const int nq = first[j + 1] - first[j];
     std::int16_t& apart = apart_line_[live];
     if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
     ConvexOverlap o;
-    if (!convex_overlap(pv, pu, np, qv, qu, nq, o, energy, inner_[live])) {
+    if (!overlap_of(pv, pu, np, qv, qu, nq, o, energy, inner_[live])) {
       apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
       continue;
     }
-    const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b
+    const Vec2 f = (kn_t * o.area) * o.normal;  // on b
     force = force + f;
     mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
     ma -= (o.centroid.x - ca_x) * f.y - (o.centroid.y - ca_y) * f.x;
@@ -720,7 +737,7 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
       // The step a pair first touches, it has touched for the part of the step its mean depth
       // |O| / L took to reach at the approach rate: the dashpot acts for that part only.
       double part = 1.0;
-      if (!touched_[p] && rate_m * dt * len > o.area) part = o.area / (rate_m * dt * len);
+      if (!touched && rate_m * dt * len > o.area) part = o.area / (rate_m * dt * len);
       const Vec2 fd = (part * c_damp * len * rate_m) * n;
       const double twist = part * c_damp * len * len * len / 12.0 * rate_s;
       damp = damp + fd;
@@ -728,13 +745,13 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
       damp_ma -= (xm.x - ca_x) * fd.y - (xm.y - ca_y) * fd.x + twist;
     }
   }
-  touched_[p] = area > 0.0;
   if (!(area > 0.0)) {
+    touched_[p] = 0;
     slip_x_[p] = slip_y_[p] = 0.0;
     return false;
   }
   const Vec2 g{gx / area, gy / area};
-  out.energy = 0.5 * kn_t_[p] * energy2;
+  out.energy = 0.5 * kn_t * energy2;
   out.fb = force;
   out.mb = mb, out.ma = ma;
   out.stored = 0.0;
@@ -748,10 +765,10 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
                  ua_y = r.vy[a] + r.omega[a] * (g.x - ca_x);
     const Vec2 du{dt * (ub_x - ua_x), dt * (ub_y - ua_y)};
     // One overlap (a joint): its force kn |O| along its normal, no square root to take again.
-    const FrictionResult fr =
-        regions == 1
-            ? coulomb_friction(kn_t_[p] * area, unit, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_)
-            : coulomb_friction(force, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_);
+    const Vec2 slip{slip_x_[p], slip_y_[p]};
+    const FrictionResult fr = regions == 1
+                                  ? coulomb_friction(kn_t * area, unit, du, slip, kt_[p], mu_)
+                                  : coulomb_friction(force, du, slip, kt_[p], mu_);
     slip_x_[p] = fr.slip.x, slip_y_[p] = fr.slip.y;
     out.stored = fr.stored;
     out.fric_b = fr.force;
@@ -766,6 +783,7 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
     out.fb = out.fb + damp;
     out.mb += damp_mb, out.ma += damp_ma;
   }
+  touched_[p] = 1;
   return true;
 }
 
@@ -776,42 +794,59 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, boo
     return;
   }
   displace_live_pieces(model);
-  double energy = 0.0, stored = 0.0;
+  const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
+  double* fx = r.fx.data();
+  double* fy = r.fy.data();
+  double* torque = r.torque.data();
+  double* damp = damp_now_.data();
+  double* fric = fric_now_.data();
+  double* pair_energy = pair_energy_.data();
+  double* pair_stored = pair_stored_.data();
   std::int64_t active = 0;
-  PairOut out;
   const std::size_t np = pair_a_.size();
   for (std::size_t p = 0; p < np; ++p) {
-    if (!evaluate(p, model, dt, with_energy, out)) continue;
+    PairOut out;
+    pair_energy[p] = pair_stored[p] = 0.0;
+    if (!evaluate(p, bodies, dt, with_energy, out)) continue;
     ++active;
-    energy += out.energy;
-    stored += out.stored;
+    pair_energy[p] = out.energy;
+    pair_stored[p] = out.stored;
     const Index a = pair_a_[p], b = pair_b_[p];
-    r.fx[b] += out.fb.x, r.fy[b] += out.fb.y, r.torque[b] += out.mb;
-    r.fx[a] -= out.fb.x, r.fy[a] -= out.fb.y, r.torque[a] += out.ma;
+    fx[b] += out.fb.x, fy[b] += out.fb.y, torque[b] += out.mb;
+    fx[a] -= out.fb.x, fy[a] -= out.fb.y, torque[a] += out.ma;
     if (damping_) {
-      damp_now_[3 * b] += out.damp_b.x, damp_now_[3 * b + 1] += out.damp_b.y;
-      damp_now_[3 * b + 2] += out.damp_mb;
-      damp_now_[3 * a] -= out.damp_b.x, damp_now_[3 * a + 1] -= out.damp_b.y;
-      damp_now_[3 * a + 2] += out.damp_ma;
+      damp[3 * b] += out.damp_b.x, damp[3 * b + 1] += out.damp_b.y;
+      damp[3 * b + 2] += out.damp_mb;
+      damp[3 * a] -= out.damp_b.x, damp[3 * a + 1] -= out.damp_b.y;
+      damp[3 * a + 2] += out.damp_ma;
     }
     if (mu_ > 0.0) {
-      fric_now_[3 * b] += out.fric_b.x, fric_now_[3 * b + 1] += out.fric_b.y;
-      fric_now_[3 * b + 2] += out.fric_mb;
-      fric_now_[3 * a] -= out.fric_b.x, fric_now_[3 * a + 1] -= out.fric_b.y;
-      fric_now_[3 * a + 2] += out.fric_ma;
+      fric[3 * b] += out.fric_b.x, fric[3 * b + 1] += out.fric_b.y;
+      fric[3 * b + 2] += out.fric_mb;
+      fric[3 * a] -= out.fric_b.x, fric[3 * a + 1] -= out.fric_b.y;
+      fric[3 * a + 2] += out.fric_ma;
     }
   }
   active_ = active;
+  // The pairs' energies summed apart from the pair loop: each product is rounded before it is
+  // added, as the ledger's figures have always been (an add fused with the product would move
+  // their last digit).
+  double energy = 0.0, stored = 0.0;
+  for (std::size_t p = 0; p < np; ++p) energy += pair_energy[p], stored += pair_stored[p];
   if (with_energy) ledger.contact = energy + stored;
   // Work of the tracked forces over the last position increment (trapezoid), bodies in order.
-  auto work_and_shift = [&](std::vector<double>& now, std::vector<double>& prev) {
+  const std::uint8_t* moves = moves_.data();
+  auto work_and_shift = [&](std::vector<double>& now_of, std::vector<double>& prev_of) {
     double work = 0.0;
-    const std::size_t nb = model.blocks.size();
+    double* now = now_of.data();
+    double* prev = prev_of.data();
+    const std::size_t nb = moves_.size();
     for (std::size_t b = 0; b < nb; ++b) {
       const double* f = &now[3 * b];
       double* g = &prev[3 * b];
-      if (has_pose(model, b))
-        work += (f[0] + g[0]) * r.vx[b] + (f[1] + g[1]) * r.vy[b] + (f[2] + g[2]) * r.omega[b];
+      if (moves[b])
+        work += (f[0] + g[0]) * bodies.vx[b] + (f[1] + g[1]) * bodies.vy[b] +
+                (f[2] + g[2]) * bodies.omega[b];
       g[0] = f[0], g[1] = f[1], g[2] = f[2];
       now[3 * b] = now[3 * b + 1] = now[3 * b + 2] = 0.0;
     }
@@ -832,9 +867,10 @@ std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double
   if (copy.needs_detection(model)) copy.detect(model);
   const RigidBodies& r = model.rigid;
   copy.displace_live_pieces(model);
+  const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
   PairOut out;
   for (std::size_t p = 0; p < copy.pair_a_.size(); ++p) {
-    if (!copy.evaluate(p, model, dt, true, out)) continue;
+    if (!copy.evaluate(p, bodies, dt, true, out)) continue;
     BlockPairForce f;
     f.block_a = copy.pair_a_[p], f.block_b = copy.pair_b_[p];
     f.force = out.fb;

@@ -199,7 +199,11 @@ class RigidContact {
   double piece_gap(Index i, Index j) const;
   std::uint32_t inner_lines(const Model& model, const std::vector<double>& ux,
                             const std::vector<double>& uy, Index i, Index j) const;
-  bool evaluate(std::size_t p, const Model& model, double dt, bool energy, PairOut& out);
+  // The bodies' centroids and half-step velocities, as the pair loop reads them.
+  struct BodyView {
+    const double *cx, *cy, *vx, *vy, *omega;
+  };
+  bool evaluate(std::size_t p, const BodyView& bodies, double dt, bool energy, PairOut& out);
   void pair_constants(const Model& model);
 
   // Parameters.
@@ -222,6 +226,9 @@ class RigidContact {
   std::vector<Vec2> offset_;
   // Per block: farthest outline point from the reference centroid [m], longest side [m].
   std::vector<double> radius_, longest_side_;
+  // Per block: 1 when it has a pose of its own (a free body, or a support that moves), as at the
+  // last detection.
+  std::vector<std::uint8_t> moves_;
   // Joints between block pairs (model.joints), for the pair constants.
   struct JointInfo {
     Index a, b;  // a < b
@@ -243,6 +250,8 @@ class RigidContact {
   std::vector<double> slip_x_, slip_y_;   // friction state [m]
   std::vector<std::uint8_t> touched_;     // 1 when the pair touched at the last step
   std::vector<double> last_w_;            // 4 per pair: F_x, F_y, M_b, M_a of the last step
+  // Scratch of add_forces: each pair's joint energy and friction spring energy of the step [J].
+  std::vector<double> pair_energy_, pair_stored_;
   // The pairs of convex pieces of each candidate pair that were within the buffer at the
   // detection (pair p's: [live_first_[p], live_first_[p + 1]) of live_i_, live_j_), and for
   // each a side line that separated them at the last evaluation, or -1 (separated_by's
