@@ -185,8 +185,9 @@ namespace {
 // vertices. kDisp: the vertices carry displacements pu, qu. Lines of Q with a bit in `inner`
 // are skipped (P wholly on their inner side).
 template <bool kDisp>
-Clipped* clip_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
-                      std::uint32_t inner, Clipped (&buf)[2]) {
+[[gnu::always_inline]] inline Clipped* clip_overlap(const Vec2* p, const Vec2* pu, int np,
+                                                    const Vec2* q, const Vec2* qu, int nq,
+                                                    std::uint32_t inner, Clipped (&buf)[2]) {
   double qx[kMaxPieceVertices + 1], qy[kMaxPieceVertices + 1];
   double d[kMaxClipped];
   // Coordinates relative to P's first vertex, reference and displacement parts apart: a joint's
@@ -424,14 +425,20 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
 
 bool RigidContact::needs_detection(const Model& model) const {
   if (!detected_) return true;
-  const RigidBodies& r = model.rigid;
+  const double* ux = model.rigid.ux.data();
+  const double* uy = model.rigid.uy.data();
+  const double* theta = model.rigid.theta.data();
+  const double* ux0 = ref_ux_.data();
+  const double* uy0 = ref_uy_.data();
+  const double* theta0 = ref_theta_.data();
+  const double* radius = radius_.data();
+  const std::uint8_t* moves = moves_.data();
   const double half = 0.5 * broad_.buffer();
-  const std::size_t nb = model.blocks.size();
+  const std::size_t nb = moves_.size();
   for (std::size_t b = 0; b < nb; ++b) {
-    if (!has_pose(model, b)) continue;
-    const double dx = r.ux[b] - ref_ux_[b], dy = r.uy[b] - ref_uy_[b];
-    const double moved =
-        std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
+    if (!moves[b]) continue;
+    const double dx = ux[b] - ux0[b], dy = uy[b] - uy0[b];
+    const double moved = std::sqrt(dx * dx + dy * dy) + radius[b] * std::abs(theta[b] - theta0[b]);
     if (moved > half) return true;
   }
   return false;
