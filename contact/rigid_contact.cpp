@@ -706,22 +706,9 @@ void RigidContact::displace_live_pieces(const Model& model) {
   Vec2 damp;                              // the dashpots' force on b
   double damp_mb = 0.0, damp_ma = 0.0;    // and their moments on b and on a
   const double c_damp = beta_[p] * kn_t;  // beta kn t_z [N s/m2]
-  const Index* first = piece_first_.data();
-  const Vec2* ref = ref_.data();
-  const Vec2* disp = disp_.data();
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
-    const Index i = live_i_[live], j = live_j_[live];
-    const Vec2 *pv = &ref[first[i]], *pu = &disp[first[i]];
-    const Vec2 *qv = &ref[first[j]], *qu = &disp[first[j]];
-    const int np = first[i + 1] - first[i];
-    const int nq = first[j + 1] - first[j];
-    std::int16_t& apart = apart_line_[live];
-    if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
-    ConvexOverlap o;
-    if (!overlap_of(pv, pu, np, qv, qu, nq, o, energy, inner_[live])) {
-      apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
-      continue;
-    }
+    if (!overlap_on_[live]) continue;
+    const ConvexOverlap& o = overlap_[live];
     const Vec2 f = (kn_t * o.area) * o.normal;  // on b
     force = force + f;
     mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
@@ -794,6 +781,31 @@ void RigidContact::displace_live_pieces(const Model& model) {
   return true;
 }
 
+// The overlap of every live pair of pieces at the current configuration (overlap_,
+// overlap_on_), and the separating lines of those apart.
+void RigidContact::overlap_pieces(bool energy) {
+  const Index* first = piece_first_.data();
+  const Vec2* ref = ref_.data();
+  const Vec2* disp = disp_.data();
+  const std::size_t n = live_i_.size();
+  overlap_.resize(n), overlap_on_.resize(n);
+  for (std::size_t live = 0; live < n; ++live) {
+    const Index i = live_i_[live], j = live_j_[live];
+    const Vec2 *pv = &ref[first[i]], *pu = &disp[first[i]];
+    const Vec2 *qv = &ref[first[j]], *qu = &disp[first[j]];
+    const int np = first[i + 1] - first[i];
+    const int nq = first[j + 1] - first[j];
+    std::int16_t& apart = apart_line_[live];
+    overlap_on_[live] = 0;
+    if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
+    if (!overlap_of(pv, pu, np, qv, qu, nq, overlap_[live], energy, inner_[live])) {
+      apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
+      continue;
+    }
+    overlap_on_[live] = 1;
+  }
+}
+
 void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, bool with_energy) {
   RigidBodies& r = model.rigid;
   if (!detected_) {
@@ -801,6 +813,7 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, boo
     return;
   }
   displace_live_pieces(model);
+  overlap_pieces(with_energy);
   const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
   double* fx = r.fx.data();
   double* fy = r.fy.data();
@@ -874,6 +887,7 @@ std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double
   if (copy.needs_detection(model)) copy.detect(model);
   const RigidBodies& r = model.rigid;
   copy.displace_live_pieces(model);
+  copy.overlap_pieces(true);
   const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
   PairOut out;
   for (std::size_t p = 0; p < copy.pair_a_.size(); ++p) {

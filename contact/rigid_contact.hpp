@@ -196,6 +196,7 @@ class RigidContact {
   void displace_pieces(const Model& model, const std::vector<double>& ux,
                        const std::vector<double>& uy, const std::vector<double>& theta);
   void displace_live_pieces(const Model& model);
+  void overlap_pieces(bool energy);
   double piece_gap(Index i, Index j) const;
   std::uint32_t inner_lines(const Model& model, const std::vector<double>& ux,
                             const std::vector<double>& uy, Index i, Index j) const;
@@ -250,8 +251,11 @@ class RigidContact {
   std::vector<double> slip_x_, slip_y_;   // friction state [m]
   std::vector<std::uint8_t> touched_;     // 1 when the pair touched at the last step
   std::vector<double> last_w_;            // 4 per pair: F_x, F_y, M_b, M_a of the last step
-  // Scratch of add_forces: each pair's joint energy and friction spring energy of the step [J].
+  // Scratch of add_forces: each pair's joint energy and friction spring energy of the step [J],
+  // and the overlap of each live pair of pieces (overlap_on_ 1 when they overlap).
   std::vector<double> pair_energy_, pair_stored_;
+  std::vector<ConvexOverlap> overlap_;
+  std::vector<std::uint8_t> overlap_on_;
   // The pairs of convex pieces of each candidate pair that were within the buffer at the
   // detection (pair p's: [live_first_[p], live_first_[p + 1]) of live_i_, live_j_), and for
   // each a side line that separated them at the last evaluation, or -1 (separated_by's
