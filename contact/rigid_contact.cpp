@@ -570,7 +570,8 @@ std::uint32_t RigidContact::inner_lines(const Model& model, const std::vector<do
   const std::size_t bi = std::size_t(piece_block_[i]), bj = std::size_t(piece_block_[j]);
   const double half = 0.5 * broad_.buffer();
   const double move_p = has_pose(model, bi) ? half : 0.0;
-  const bool q_moves = has_pose(model, bj) && radius_[bj] > 0.0;
+  const bool q_moves = has_pose(model, bj);
+  if (q_moves && !(radius_[bj] > 0.0)) return 0;  // no bound on the line's turn
   const double cqx = q_moves ? r.cx0[bj] + ux[bj] : 0.0, cqy = q_moves ? r.cy0[bj] + uy[bj] : 0.0;
   auto at = [this](Index v) { return Vec2{ref_[v].x + disp_[v].x, ref_[v].y + disp_[v].y}; };
   const Index q0 = piece_first_[j], nq = piece_first_[j + 1] - q0;
