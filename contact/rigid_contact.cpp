@@ -3,6 +3,8 @@
 #include "contact/rigid_contact.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cassert>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -17,39 +19,48 @@ namespace voussoir {
 
 namespace {
 
-// Labels of a clipped vertex: the boundary its outgoing edge lies on.
-constexpr std::uint8_t kOnP = 0, kOnQ = 1;
-// Largest vertex count of a clipped polygon: P's vertices plus two per line of Q.
+// Largest vertex count of a clipped polygon: P's vertices plus two per line of Q, plus one slot
+// for the copy of the first vertex after the last (the loops over edges read vertex k + 1).
 constexpr int kMaxClipped = 3 * kMaxPieceVertices + 4;
+static_assert(kMaxClipped <= 64, "a polygon's edge labels fit one 64-bit mask");
 
-// A point of the kernel's scratch arrays (no initialiser: the arrays are written before read).
-struct Pt {
-  double x, y;
+// A polygon of the clipping, in coordinates relative to P's first vertex [m], with the labels of
+// rigid_contact.hpp: bit k of `on` is 1 when vertex k's outgoing edge lies on a line of Q, 0 on
+// P's boundary. No initialiser: written before read.
+struct Clipped {
+  double x[kMaxClipped], y[kMaxClipped];
+  std::uint64_t on;
+  int n;
 };
 
-// Clips the convex polygon (in, n) by the inner side of a line of Q (d: each vertex's signed
-// distance to it times the side's length, >= 0 inside); returns the vertex count of `out`
-// (Sutherland-Hodgman with the edge labels of rigid_contact.hpp).
-int clip_by_line(const Pt* in, const std::uint8_t* in_on, int n, const double* d, Pt* out,
-                 std::uint8_t* out_on) {
+// Clips the convex polygon `in` by the inner side of a line of Q (d: each vertex's signed
+// distance to it times the side's length, >= 0 inside) into `out` (Sutherland and Hodgman with
+// the edge labels of rigid_contact.hpp).
+inline void clip_by_line(const Clipped& in, const double* d, Clipped& out) {
   int m = 0;
-  int prev = n - 1;
-  for (int k = 0; k < n; ++k) {
-    const bool prev_in = d[prev] >= 0.0, cur_in = d[k] >= 0.0;
+  std::uint64_t on = 0;
+  int prev = in.n - 1;
+  bool prev_in = d[prev] >= 0.0;
+  for (int k = 0; k < in.n; ++k) {
+    const bool cur_in = d[k] >= 0.0;
     if (cur_in != prev_in) {
       const double t = d[prev] / (d[prev] - d[k]);
-      out[m] = {in[prev].x + t * (in[k].x - in[prev].x), in[prev].y + t * (in[k].y - in[prev].y)};
+      out.x[m] = in.x[prev] + t * (in.x[k] - in.x[prev]);
+      out.y[m] = in.y[prev] + t * (in.y[k] - in.y[prev]);
       // Entering: the edge from here runs on along P's (or the earlier line's) edge; leaving:
       // along this line of Q.
-      out_on[m++] = cur_in ? in_on[prev] : kOnQ;
+      on |= (cur_in ? (in.on >> prev) & 1 : std::uint64_t(1)) << m++;
     }
     if (cur_in) {
-      out[m] = in[k];
-      out_on[m++] = in_on[k];
+      out.x[m] = in.x[k];
+      out.y[m] = in.y[k];
+      on |= ((in.on >> k) & 1) << m++;
     }
     prev = k;
+    prev_in = cur_in;
   }
-  return m;
+  out.on = on;
+  out.n = m;
 }
 
 // integral of d(s)^2 ds of the convex polygon (s, h) (n vertices, counter-clockwise in the
@@ -86,13 +97,16 @@ double width_squared_integral(const double* s, const double* h, int n) {
 // sin and cos of theta / 2. Blocks at rest or near it turn by 1e-9 to 1e-3 rad: below 0.02 rad
 // the Taylor series to x^9 (x = theta / 2; the next term is below 1e-17 relative) replaces the
 // library's calls, a tenth of a joint's cost each.
+// The coefficients are constants of the program (the build's -frounding-math, which CGAL asks
+// for, would otherwise divide them out at every call).
 inline void half_angle(double theta, double& s, double& c) {
+  constexpr double kS3 = -1.0 / 6, kS5 = 1.0 / 120, kS7 = -1.0 / 5040, kS9 = 1.0 / 362880;
+  constexpr double kC4 = 1.0 / 24, kC6 = -1.0 / 720, kC8 = 1.0 / 40320, kC10 = 1.0 / 3628800;
   const double x = 0.5 * theta;
   if (std::abs(x) < 0.01) {
     const double x2 = x * x;
-    s = x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880)))));
-    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 +
-                                 x2 * (-1.0 / 720 + x2 * (1.0 / 40320 - x2 * (1.0 / 3628800)))));
+    s = x * (1.0 + x2 * (kS3 + x2 * (kS5 + x2 * (kS7 + x2 * kS9))));
+    c = 1.0 + x2 * (-0.5 + x2 * (kC4 + x2 * (kC6 + x2 * (kC8 - x2 * kC10))));
   } else {
     s = std::sin(x);
     c = std::cos(x);
@@ -167,81 +181,85 @@ std::vector<std::vector<Index>> merged_triangles(const Model& model, Index b) {
 namespace {
 
 // The clipping stage of convex_overlap: O = P n Q in coordinates relative to P's first vertex
-// (ox, oy plus its displacement), into buf[cur] and on[cur]; returns O's vertex count (< 3: no
-// overlap) and sets cur. kDisp: the vertices carry displacements pu, qu.
+// (plus its displacement), into one of `buf`; returns it, or null when O has fewer than three
+// vertices. kDisp: the vertices carry displacements pu, qu. Lines of Q with a bit in `inner`
+// are skipped (P wholly on their inner side).
 template <bool kDisp>
-int clip_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
-                 Pt (&buf)[2][kMaxClipped], std::uint8_t (&on)[2][kMaxClipped], int& cur) {
-  Pt qv[kMaxClipped];
+[[gnu::always_inline]] inline Clipped* clip_overlap(const Vec2* p, const Vec2* pu, int np,
+                                                    const Vec2* q, const Vec2* qu, int nq,
+                                                    std::uint32_t inner, Clipped (&buf)[2]) {
+  double qx[kMaxPieceVertices + 1], qy[kMaxPieceVertices + 1];
   double d[kMaxClipped];
   // Coordinates relative to P's first vertex, reference and displacement parts apart: a joint's
   // two faces share their reference vertices, so a penetration of 1e-12 m is resolved to
   // round-off of itself, not of the coordinates (rigid_contact.hpp, "Exactness").
   const double ox = p[0].x, oy = p[0].y;
   const double oux = kDisp ? pu[0].x : 0.0, ouy = kDisp ? pu[0].y : 0.0;
+  Clipped* v = &buf[0];
   for (int k = 0; k < np; ++k) {
-    buf[0][k] = {(p[k].x - ox) + (kDisp ? pu[k].x - oux : 0.0),
-                 (p[k].y - oy) + (kDisp ? pu[k].y - ouy : 0.0)};
-    on[0][k] = kOnP;
+    v->x[k] = (p[k].x - ox) + (kDisp ? pu[k].x - oux : 0.0);
+    v->y[k] = (p[k].y - oy) + (kDisp ? pu[k].y - ouy : 0.0);
   }
-  for (int j = 0; j < nq; ++j)
-    qv[j] = {(q[j].x - ox) + (kDisp ? qu[j].x - oux : 0.0),
-             (q[j].y - oy) + (kDisp ? qu[j].y - ouy : 0.0)};
-  int n = np;
-  cur = 0;
+  v->on = 0;  // every edge on P
+  v->n = np;
   for (int j = 0; j < nq; ++j) {
-    const int j1 = j + 1 < nq ? j + 1 : 0;
-    const double ax = qv[j].x, ay = qv[j].y;
-    const double ex = qv[j1].x - ax, ey = qv[j1].y - ay;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    const Pt* v = buf[cur];
+    qx[j] = (q[j].x - ox) + (kDisp ? qu[j].x - oux : 0.0);
+    qy[j] = (q[j].y - oy) + (kDisp ? qu[j].y - ouy : 0.0);
+  }
+  qx[nq] = qx[0], qy[nq] = qy[0];
+  for (int j = 0; j < nq; ++j) {
+    const double ax = qx[j], ay = qy[j];
+    const double ex = qx[j + 1] - ax, ey = qy[j + 1] - ay;
+    const int n = v->n;
+    if ((inner >> j) & 1) {
+      for (int k = 0; k < n; ++k) assert(ex * (v->y[k] - ay) - ey * (v->x[k] - ax) >= 0.0);
+      continue;
+    }
+    long inside = 0, outside = 0;  // counts of d >= 0 and of d < 0
     for (int k = 0; k < n; ++k) {
       // Differences first: a vertex near the line gets its distance to its own round-off.
-      d[k] = ex * (v[k].y - ay) - ey * (v[k].x - ax);
-      lo = std::min(lo, d[k]);
-      hi = std::max(hi, d[k]);
+      d[k] = ex * (v->y[k] - ay) - ey * (v->x[k] - ax);
+      inside += d[k] >= 0.0;
+      outside += d[k] < 0.0;
     }
-    if (hi < 0.0) return 0;   // P wholly outside this side of Q
-    if (lo >= 0.0) continue;  // wholly inside: nothing to cut
-    n = clip_by_line(buf[cur], on[cur], n, d, buf[1 - cur], on[1 - cur]);
-    cur = 1 - cur;
-    if (n < 3) return 0;
+    if (inside == 0) return nullptr;  // P wholly outside this side of Q
+    if (outside == 0) continue;       // wholly inside: nothing to cut
+    Clipped* next = v == &buf[0] ? &buf[1] : &buf[0];
+    clip_by_line(*v, d, *next);
+    v = next;
+    if (v->n < 3) return nullptr;
   }
-  return n;
+  return v;
 }
 
-}  // namespace
-
-bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
-                    bool with_energy) {
-  return convex_overlap(p, nullptr, np, q, nullptr, nq, out, with_energy);
-}
-
-bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
-                    ConvexOverlap& out, bool with_energy) {
-  Pt buf[2][kMaxClipped];
-  std::uint8_t on[2][kMaxClipped];
-  int cur = 0;
-  const int n = pu && qu ? clip_overlap<true>(p, pu, np, q, qu, nq, buf, on, cur)
-                         : clip_overlap<false>(p, pu, np, q, qu, nq, buf, on, cur);
-  if (n < 3) return false;
+// convex_overlap, inlined into the contact stage's pair loop.
+[[gnu::always_inline]] inline bool overlap_of(const Vec2* p, const Vec2* pu, int np, const Vec2* q,
+                                              const Vec2* qu, int nq, ConvexOverlap& out,
+                                              bool with_energy, std::uint32_t inner) {
+  Clipped buf[2];
+  Clipped* o = pu && qu ? clip_overlap<true>(p, pu, np, q, qu, nq, inner, buf)
+                        : clip_overlap<false>(p, pu, np, q, qu, nq, inner, buf);
+  if (!o) return false;
+  const int n = o->n;
   const double ox = p[0].x + (pu && qu ? pu[0].x : 0.0);
   const double oy = p[0].y + (pu && qu ? pu[0].y : 0.0);
-  const Pt* v = buf[cur];
-  const std::uint8_t* lab = on[cur];
+  // O's vertices, the first one copied after the last.
+  double* vx = o->x;
+  double* vy = o->y;
+  vx[n] = vx[0], vy[n] = vy[0];
+  const std::uint64_t lab = o->on;
   // Area and first moment about O's first vertex (Green's theorem: a sliver's terms are then
   // each of its own size), and P's outward normals times lengths.
-  const double vx0 = v[0].x, vy0 = v[0].y;
+  const double vx0 = vx[0], vy0 = vy[0];
   // n = (N_P - N_Q) / 2: P's edges count +1/2, Q's -1/2.
   double a2 = 0.0, mx = 0.0, my = 0.0, nx = 0.0, ny = 0.0;
   for (int k = 0; k < n; ++k) {
-    const int k1 = k + 1 < n ? k + 1 : 0;
-    const double x0 = v[k].x - vx0, y0 = v[k].y - vy0, x1 = v[k1].x - vx0, y1 = v[k1].y - vy0;
+    const double x0 = vx[k] - vx0, y0 = vy[k] - vy0, x1 = vx[k + 1] - vx0, y1 = vy[k + 1] - vy0;
     const double c = x0 * y1 - y0 * x1;
     a2 += c;
     mx += (x0 + x1) * c;
     my += (y0 + y1) * c;
-    const double w = lab[k] == kOnP ? 0.5 : -0.5;
+    const double w = (lab >> k) & 1 ? -0.5 : 0.5;
     nx += w * (y1 - y0);
     ny -= w * (x1 - x0);
   }
@@ -254,23 +272,40 @@ bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const 
   out.normal = {nx * inv_chord, ny * inv_chord};
   out.chord = chord;
   // The points where the outlines cross: where a vertex's edges change from one outline to the
-  // other.
-  int crossings = 0;
-  double mx0 = 0.0, my0 = 0.0;
-  for (int k = 0; k < n; ++k)
-    if (lab[k] != lab[k > 0 ? k - 1 : n - 1]) mx0 += v[k].x, my0 += v[k].y, ++crossings;
-  out.chord_mid = crossings == 2 ? Vec2{ox + 0.5 * mx0, oy + 0.5 * my0} : out.centroid;
+  // other (its label differs from the previous vertex's).
+  const std::uint64_t all = n < 64 ? (std::uint64_t(1) << n) - 1 : ~std::uint64_t(0);
+  const std::uint64_t crossing = (lab ^ ((lab << 1) | (lab >> (n - 1)))) & all;
+  out.chord_mid = out.centroid;
+  if (std::popcount(crossing) == 2) {
+    const int k0 = std::countr_zero(crossing), k1 = 63 - std::countl_zero(crossing);
+    double mx0 = 0.0, my0 = 0.0;
+    mx0 += vx[k0], my0 += vy[k0];
+    mx0 += vx[k1], my0 += vy[k1];
+    out.chord_mid = {ox + 0.5 * mx0, oy + 0.5 * my0};
+  }
   out.depth_sq = 0.0;
   if (!with_energy) return true;
   // integral d^2 ds in the frame s along (n_y, -n_x), h along n (right-handed).
   double s[kMaxClipped], h[kMaxClipped];
   const double tx = out.normal.y, ty = -out.normal.x;
   for (int k = 0; k < n; ++k) {
-    s[k] = tx * v[k].x + ty * v[k].y;
-    h[k] = out.normal.x * v[k].x + out.normal.y * v[k].y;
+    s[k] = tx * vx[k] + ty * vy[k];
+    h[k] = out.normal.x * vx[k] + out.normal.y * vy[k];
   }
   out.depth_sq = width_squared_integral(s, h, n);
   return true;
+}
+
+}  // namespace
+
+bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
+                    bool with_energy) {
+  return convex_overlap(p, nullptr, np, q, nullptr, nq, out, with_energy);
+}
+
+bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
+                    ConvexOverlap& out, bool with_energy, std::uint32_t inner) {
+  return overlap_of(p, pu, np, q, qu, nq, out, with_energy, inner);
 }
 
 int separating_line(const Vec2* p, int np, const Vec2* q, int nq) {
@@ -322,6 +357,7 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
   // Convex pieces (offsets from the reference centroid for free blocks).
   const std::size_t nb = model.blocks.size();
   piece_first_.assign(1, 0);
+  piece_block_.clear();
   block_piece_.assign(1, 0);
   ref_.clear();
   radius_.assign(nb, 0.0);
@@ -346,6 +382,7 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
     for (const std::vector<Vec2>& piece : pieces) {
       ref_.insert(ref_.end(), piece.begin(), piece.end());
       piece_first_.push_back(Index(ref_.size()));
+      piece_block_.push_back(Index(b));
     }
     block_piece_.push_back(Index(piece_first_.size() - 1));
     for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i)
@@ -388,14 +425,20 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
 
 bool RigidContact::needs_detection(const Model& model) const {
   if (!detected_) return true;
-  const RigidBodies& r = model.rigid;
+  const double* ux = model.rigid.ux.data();
+  const double* uy = model.rigid.uy.data();
+  const double* theta = model.rigid.theta.data();
+  const double* ux0 = ref_ux_.data();
+  const double* uy0 = ref_uy_.data();
+  const double* theta0 = ref_theta_.data();
+  const double* radius = radius_.data();
+  const std::uint8_t* moves = moves_.data();
   const double half = 0.5 * broad_.buffer();
-  const std::size_t nb = model.blocks.size();
+  const std::size_t nb = moves_.size();
   for (std::size_t b = 0; b < nb; ++b) {
-    if (!has_pose(model, b)) continue;
-    const double dx = r.ux[b] - ref_ux_[b], dy = r.uy[b] - ref_uy_[b];
-    const double moved =
-        std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(r.theta[b] - ref_theta_[b]);
+    if (!moves[b]) continue;
+    const double dx = ux[b] - ux0[b], dy = uy[b] - uy0[b];
+    const double moved = std::sqrt(dx * dx + dy * dy) + radius[b] * std::abs(theta[b] - theta0[b]);
     if (moved > half) return true;
   }
   return false;
@@ -449,6 +492,25 @@ void RigidContact::detect_at(const Model& model, const std::vector<double>& ux,
   }
   next.swap(kept);
   live_first_.swap(live_first), live_i_.swap(live_i), live_j_.swap(live_j);
+  inner_.resize(live_i_.size());
+  for (std::size_t l = 0; l < live_i_.size(); ++l)
+    inner_[l] = inner_lines(model, ux, uy, live_i_[l], live_j_[l]);
+  moves_.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) moves_[b] = has_pose(model, b);
+  // The pieces the steps displace: those of the live pairs on bodies with a pose, in order.
+  std::vector<char> live_piece(piece_block_.size(), 0);
+  for (std::size_t l = 0; l < live_i_.size(); ++l)
+    live_piece[live_i_[l]] = live_piece[live_j_[l]] = 1;
+  moving_pieces_.clear();
+  for (std::size_t k = 0; k < live_piece.size(); ++k)
+    if (live_piece[k] && has_pose(model, std::size_t(piece_block_[k])))
+      moving_pieces_.push_back(Index(k));
+  offset_.resize(ref_.size());
+  for (const Index k : moving_pieces_) {
+    const std::size_t b = std::size_t(piece_block_[k]);
+    for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v)
+      offset_[v] = {ref_[v].x - r.cx0[b], ref_[v].y - r.cy0[b]};
+  }
   // Carry the friction slip and whether the pair touched by the block pair.
   const std::size_t np = next.size();
   std::vector<Index> na(np), nbk(np);
@@ -498,11 +560,49 @@ double RigidContact::piece_gap(Index i, Index j) const {
   return gap;
 }
 
+// The side lines of piece j (bit k: from vertex k to k + 1) that keep every vertex of piece i on
+// their inner side, by more than the two pieces can move towards the line before the next
+// detection (rigid_contact.hpp, "Lines that cannot cut"); at the detection's configuration
+// (disp_), the bodies displaced by (ux, uy).
+std::uint32_t RigidContact::inner_lines(const Model& model, const std::vector<double>& ux,
+                                        const std::vector<double>& uy, Index i, Index j) const {
+  const RigidBodies& r = model.rigid;
+  const std::size_t bi = std::size_t(piece_block_[i]), bj = std::size_t(piece_block_[j]);
+  const double half = 0.5 * broad_.buffer();
+  const double move_p = has_pose(model, bi) ? half : 0.0;
+  const bool q_moves = has_pose(model, bj);
+  if (q_moves && !(radius_[bj] > 0.0)) return 0;  // no bound on the line's turn
+  const double cqx = q_moves ? r.cx0[bj] + ux[bj] : 0.0, cqy = q_moves ? r.cy0[bj] + uy[bj] : 0.0;
+  auto at = [this](Index v) { return Vec2{ref_[v].x + disp_[v].x, ref_[v].y + disp_[v].y}; };
+  const Index q0 = piece_first_[j], nq = piece_first_[j + 1] - q0;
+  std::uint32_t inner = 0;
+  for (Index k = 0; k < nq; ++k) {
+    const Vec2 a = at(q0 + k), e = at(q0 + (k + 1 < nq ? k + 1 : 0)) - a;
+    const double len = std::hypot(e.x, e.y);
+    if (!(len > 0.0)) continue;
+    bool all_inside = true;
+    for (Index w = piece_first_[i]; w < piece_first_[i + 1] && all_inside; ++w) {
+      const Vec2 v = at(w);
+      const double dist = cross(e, v - a) / len;
+      // Q's material point at v moves by at most |dc_Q| + |dtheta_Q| |v - c_Q|, which the
+      // detection rule bounds by buffer / 2 times max(1, |v - c_Q| / R_Q).
+      const double move_q =
+          q_moves ? half * std::max(1.0, std::hypot(v.x - cqx, v.y - cqy) / radius_[bj]) : 0.0;
+      const double slack = kInnerLineSlack * (broad_.buffer() + std::abs(a.x) + std::abs(a.y) +
+                                              std::abs(v.x) + std::abs(v.y));
+      all_inside = dist > move_p + move_q + slack;
+    }
+    if (all_inside) inner |= std::uint32_t(1) << k;
+  }
+  return inner;
+}
+
 // kn t_z, k_t and beta of each candidate pair, from the reference geometry only (so a restart's
 // detection gives the same values).
 void RigidContact::pair_constants(const Model& model) {
   const std::size_t np = pair_a_.size();
   kn_t_.resize(np), kt_.resize(np), beta_.resize(np);
+  pair_energy_.resize(np), pair_stored_.resize(np);
   for (std::size_t p = 0; p < np; ++p) {
     const Index a = pair_a_[p], b = pair_b_[p];
     const Block& ba = model.blocks[std::size_t(a)];
@@ -566,34 +666,51 @@ void RigidContact::displace_pieces(const Model& model, const std::vector<double>
   }
 }
 
+// displace_pieces for the pieces of the live pairs, at the bodies' current poses (the same
+// numbers, with the offsets r computed at the detection).
+void RigidContact::displace_live_pieces(const Model& model) {
+  const double* ux = model.rigid.ux.data();
+  const double* uy = model.rigid.uy.data();
+  const double* theta = model.rigid.theta.data();
+  const Index* first = piece_first_.data();
+  const Vec2* offset = offset_.data();
+  Vec2* disp = disp_.data();
+  Index block = -1;
+  double cm1 = 0.0, s = 0.0, bx = 0.0, by = 0.0;
+  for (const Index k : moving_pieces_) {
+    if (piece_block_[k] != block) {
+      block = piece_block_[k];
+      double sh, ch;
+      half_angle(theta[block], sh, ch);
+      cm1 = -2.0 * sh * sh, s = 2.0 * sh * ch;
+      bx = ux[block], by = uy[block];
+    }
+    for (Index v = first[k]; v < first[k + 1]; ++v) {
+      const double rx = offset[v].x, ry = offset[v].y;
+      disp[v] = {bx + cm1 * rx - s * ry, by + s * rx + cm1 * ry};
+    }
+  }
+}
+
 // Pair p at the current configuration: false when its blocks do not overlap (its history is
-// then dropped).
-bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool energy,
-                            PairOut& out) {
-  const RigidBodies& r = model.rigid;
+// then dropped). Inlined into the contact stage's pair loop.
+[[gnu::always_inline]] inline bool RigidContact::evaluate(std::size_t p, const BodyView& r,
+                                                          double dt, bool energy, PairOut& out) {
   const Index a = pair_a_[p], b = pair_b_[p];
+  const double kn_t = kn_t_[p];
+  const bool touched = touched_[p];
   double area = 0.0, energy2 = 0.0, gx = 0.0, gy = 0.0;
   Vec2 force, unit;  // unit: the one overlap's normal
   int regions = 0;
   double mb = 0.0, ma = 0.0;
   const double ca_x = r.cx[a], ca_y = r.cy[a], cb_x = r.cx[b], cb_y = r.cy[b];
-  Vec2 damp;                                  // the dashpots' force on b
-  double damp_mb = 0.0, damp_ma = 0.0;        // and their moments on b and on a
-  const double c_damp = beta_[p] * kn_t_[p];  // beta kn t_z [N s/m2]
+  Vec2 damp;                              // the dashpots' force on b
+  double damp_mb = 0.0, damp_ma = 0.0;    // and their moments on b and on a
+  const double c_damp = beta_[p] * kn_t;  // beta kn t_z [N s/m2]
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
-    const Index i = live_i_[live], j = live_j_[live];
-    const Vec2 *pv = &ref_[piece_first_[i]], *pu = &disp_[piece_first_[i]];
-    const Vec2 *qv = &ref_[piece_first_[j]], *qu = &disp_[piece_first_[j]];
-    const int np = piece_first_[i + 1] - piece_first_[i];
-    const int nq = piece_first_[j + 1] - piece_first_[j];
-    std::int16_t& apart = apart_line_[live];
-    if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
-    ConvexOverlap o;
-    if (!convex_overlap(pv, pu, np, qv, qu, nq, o, energy)) {
-      apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
-      continue;
-    }
-    const Vec2 f = (kn_t_[p] * o.area) * o.normal;  // on b
+    if (!overlap_on_[live]) continue;
+    const ConvexOverlap& o = overlap_[live];
+    const Vec2 f = (kn_t * o.area) * o.normal;  // on b
     force = force + f;
     mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
     ma -= (o.centroid.x - ca_x) * f.y - (o.centroid.y - ca_y) * f.x;
@@ -615,7 +732,7 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
       // The step a pair first touches, it has touched for the part of the step its mean depth
       // |O| / L took to reach at the approach rate: the dashpot acts for that part only.
       double part = 1.0;
-      if (!touched_[p] && rate_m * dt * len > o.area) part = o.area / (rate_m * dt * len);
+      if (!touched && rate_m * dt * len > o.area) part = o.area / (rate_m * dt * len);
       const Vec2 fd = (part * c_damp * len * rate_m) * n;
       const double twist = part * c_damp * len * len * len / 12.0 * rate_s;
       damp = damp + fd;
@@ -623,13 +740,13 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
       damp_ma -= (xm.x - ca_x) * fd.y - (xm.y - ca_y) * fd.x + twist;
     }
   }
-  touched_[p] = area > 0.0;
   if (!(area > 0.0)) {
+    touched_[p] = 0;
     slip_x_[p] = slip_y_[p] = 0.0;
     return false;
   }
   const Vec2 g{gx / area, gy / area};
-  out.energy = 0.5 * kn_t_[p] * energy2;
+  out.energy = 0.5 * kn_t * energy2;
   out.fb = force;
   out.mb = mb, out.ma = ma;
   out.stored = 0.0;
@@ -643,10 +760,10 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
                  ua_y = r.vy[a] + r.omega[a] * (g.x - ca_x);
     const Vec2 du{dt * (ub_x - ua_x), dt * (ub_y - ua_y)};
     // One overlap (a joint): its force kn |O| along its normal, no square root to take again.
-    const FrictionResult fr =
-        regions == 1
-            ? coulomb_friction(kn_t_[p] * area, unit, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_)
-            : coulomb_friction(force, du, {slip_x_[p], slip_y_[p]}, kt_[p], mu_);
+    const Vec2 slip{slip_x_[p], slip_y_[p]};
+    const FrictionResult fr = regions == 1
+                                  ? coulomb_friction(kn_t * area, unit, du, slip, kt_[p], mu_)
+                                  : coulomb_friction(force, du, slip, kt_[p], mu_);
     slip_x_[p] = fr.slip.x, slip_y_[p] = fr.slip.y;
     out.stored = fr.stored;
     out.fric_b = fr.force;
@@ -661,7 +778,33 @@ bool RigidContact::evaluate(std::size_t p, const Model& model, double dt, bool e
     out.fb = out.fb + damp;
     out.mb += damp_mb, out.ma += damp_ma;
   }
+  touched_[p] = 1;
   return true;
+}
+
+// The overlap of every live pair of pieces at the current configuration (overlap_,
+// overlap_on_), and the separating lines of those apart.
+void RigidContact::overlap_pieces(bool energy) {
+  const Index* first = piece_first_.data();
+  const Vec2* ref = ref_.data();
+  const Vec2* disp = disp_.data();
+  const std::size_t n = live_i_.size();
+  overlap_.resize(n), overlap_on_.resize(n);
+  for (std::size_t live = 0; live < n; ++live) {
+    const Index i = live_i_[live], j = live_j_[live];
+    const Vec2 *pv = &ref[first[i]], *pu = &disp[first[i]];
+    const Vec2 *qv = &ref[first[j]], *qu = &disp[first[j]];
+    const int np = first[i + 1] - first[i];
+    const int nq = first[j + 1] - first[j];
+    std::int16_t& apart = apart_line_[live];
+    overlap_on_[live] = 0;
+    if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
+    if (!overlap_of(pv, pu, np, qv, qu, nq, overlap_[live], energy, inner_[live])) {
+      apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
+      continue;
+    }
+    overlap_on_[live] = 1;
+  }
 }
 
 void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, bool with_energy) {
@@ -670,43 +813,61 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, boo
     ledger.contact = 0.0;
     return;
   }
-  displace_pieces(model, r.ux, r.uy, r.theta);
-  double energy = 0.0, stored = 0.0;
+  displace_live_pieces(model);
+  overlap_pieces(with_energy);
+  const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
+  double* fx = r.fx.data();
+  double* fy = r.fy.data();
+  double* torque = r.torque.data();
+  double* damp = damp_now_.data();
+  double* fric = fric_now_.data();
+  double* pair_energy = pair_energy_.data();
+  double* pair_stored = pair_stored_.data();
   std::int64_t active = 0;
-  PairOut out;
   const std::size_t np = pair_a_.size();
   for (std::size_t p = 0; p < np; ++p) {
-    if (!evaluate(p, model, dt, with_energy, out)) continue;
+    PairOut out;
+    pair_energy[p] = pair_stored[p] = 0.0;
+    if (!evaluate(p, bodies, dt, with_energy, out)) continue;
     ++active;
-    energy += out.energy;
-    stored += out.stored;
+    pair_energy[p] = out.energy;
+    pair_stored[p] = out.stored;
     const Index a = pair_a_[p], b = pair_b_[p];
-    r.fx[b] += out.fb.x, r.fy[b] += out.fb.y, r.torque[b] += out.mb;
-    r.fx[a] -= out.fb.x, r.fy[a] -= out.fb.y, r.torque[a] += out.ma;
+    fx[b] += out.fb.x, fy[b] += out.fb.y, torque[b] += out.mb;
+    fx[a] -= out.fb.x, fy[a] -= out.fb.y, torque[a] += out.ma;
     if (damping_) {
-      damp_now_[3 * b] += out.damp_b.x, damp_now_[3 * b + 1] += out.damp_b.y;
-      damp_now_[3 * b + 2] += out.damp_mb;
-      damp_now_[3 * a] -= out.damp_b.x, damp_now_[3 * a + 1] -= out.damp_b.y;
-      damp_now_[3 * a + 2] += out.damp_ma;
+      damp[3 * b] += out.damp_b.x, damp[3 * b + 1] += out.damp_b.y;
+      damp[3 * b + 2] += out.damp_mb;
+      damp[3 * a] -= out.damp_b.x, damp[3 * a + 1] -= out.damp_b.y;
+      damp[3 * a + 2] += out.damp_ma;
     }
     if (mu_ > 0.0) {
-      fric_now_[3 * b] += out.fric_b.x, fric_now_[3 * b + 1] += out.fric_b.y;
-      fric_now_[3 * b + 2] += out.fric_mb;
-      fric_now_[3 * a] -= out.fric_b.x, fric_now_[3 * a + 1] -= out.fric_b.y;
-      fric_now_[3 * a + 2] += out.fric_ma;
+      fric[3 * b] += out.fric_b.x, fric[3 * b + 1] += out.fric_b.y;
+      fric[3 * b + 2] += out.fric_mb;
+      fric[3 * a] -= out.fric_b.x, fric[3 * a + 1] -= out.fric_b.y;
+      fric[3 * a + 2] += out.fric_ma;
     }
   }
   active_ = active;
+  // The pairs' energies summed apart from the pair loop: each product is rounded before it is
+  // added, as the ledger's figures have always been (an add fused with the product would move
+  // their last digit).
+  double energy = 0.0, stored = 0.0;
+  for (std::size_t p = 0; p < np; ++p) energy += pair_energy[p], stored += pair_stored[p];
   if (with_energy) ledger.contact = energy + stored;
   // Work of the tracked forces over the last position increment (trapezoid), bodies in order.
-  auto work_and_shift = [&](std::vector<double>& now, std::vector<double>& prev) {
+  const std::uint8_t* moves = moves_.data();
+  auto work_and_shift = [&](std::vector<double>& now_of, std::vector<double>& prev_of) {
     double work = 0.0;
-    const std::size_t nb = model.blocks.size();
+    double* now = now_of.data();
+    double* prev = prev_of.data();
+    const std::size_t nb = moves_.size();
     for (std::size_t b = 0; b < nb; ++b) {
       const double* f = &now[3 * b];
       double* g = &prev[3 * b];
-      if (has_pose(model, b))
-        work += (f[0] + g[0]) * r.vx[b] + (f[1] + g[1]) * r.vy[b] + (f[2] + g[2]) * r.omega[b];
+      if (moves[b])
+        work += (f[0] + g[0]) * bodies.vx[b] + (f[1] + g[1]) * bodies.vy[b] +
+                (f[2] + g[2]) * bodies.omega[b];
       g[0] = f[0], g[1] = f[1], g[2] = f[2];
       now[3 * b] = now[3 * b + 1] = now[3 * b + 2] = 0.0;
     }
@@ -726,10 +887,12 @@ std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double
   RigidContact copy(*this);
   if (copy.needs_detection(model)) copy.detect(model);
   const RigidBodies& r = model.rigid;
-  copy.displace_pieces(model, r.ux, r.uy, r.theta);
+  copy.displace_live_pieces(model);
+  copy.overlap_pieces(true);
+  const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
   PairOut out;
   for (std::size_t p = 0; p < copy.pair_a_.size(); ++p) {
-    if (!copy.evaluate(p, model, dt, true, out)) continue;
+    if (!copy.evaluate(p, bodies, dt, true, out)) continue;
     BlockPairForce f;
     f.block_a = copy.pair_a_[p], f.block_b = copy.pair_b_[p];
     f.force = out.fb;

@@ -79,6 +79,16 @@
 // trapezoid over the body's position increment (dt v^(n-1/2), dt omega^(n-1/2)), as the
 // element damping of core/; friction books its work less the change of its springs' energy.
 //
+// Lines that cannot cut. Until the next detection every outline point moves by at most
+// buffer / 2 from where it was at the detection. A side line of B's piece therefore keeps every
+// vertex v of A's piece on its inner side when, at the detection, v lies inside it by more than
+// what the two can move towards each other: buffer / 2 for v (if A moves) plus, for the line,
+// the move of B's material point at v, |dc_B| + |dtheta_B| |v - c_B| <= buffer / 2 max(1,
+// |v - c_B| / R_B) (if B moves). Every vertex of the polygon being clipped lies in A's piece, so
+// such a line would leave it whole: the clipping skips it, and the result is the same to the
+// bit. On a face-to-face joint this is the far side of B's piece (the other sides pass through
+// the joint's corners). A margin of kInnerLineSlack times the coordinates covers round-off.
+//
 // Detection: the NBS grid of contact/broad_phase.hpp on the blocks' outline triangles, node
 // positions taken from the bodies at detection only, candidate triangle pairs folded into
 // candidate block pairs, and of those the pairs whose outlines are within the buffer of each
@@ -111,6 +121,9 @@ struct ConvexOverlap {
 
 // Most vertices a convex piece may have (a piece is cut further when larger).
 inline constexpr int kMaxPieceVertices = 16;
+// Relative margin for round-off in the certificate of "Lines that cannot cut" (dimensionless:
+// times the coordinates and the buffer; round-off is 1e-16 of them).
+inline constexpr double kInnerLineSlack = 1e-9;
 
 // The overlap of P (np vertices) and Q (nq vertices); false when they do not overlap (or O has
 // no area, or P lies wholly inside Q and O has no chord). depth_sq only `with_energy` (else 0):
@@ -118,9 +131,11 @@ inline constexpr int kMaxPieceVertices = 16;
 bool convex_overlap(const Vec2* p, int np, const Vec2* q, int nq, ConvexOverlap& out,
                     bool with_energy = true);
 // The same with each vertex given as a reference position plus a displacement (pu, qu; null:
-// none), which the kernel keeps apart until the differences are taken.
+// none), which the kernel keeps apart until the differences are taken. `inner`: side lines of Q
+// (bit j: line j, from q[j] to q[j + 1]) known to have P wholly on their inner side, which the
+// clipping skips (the result is the same; RigidContact certifies them at detection).
 bool convex_overlap(const Vec2* p, const Vec2* pu, int np, const Vec2* q, const Vec2* qu, int nq,
-                    ConvexOverlap& out, bool with_energy);
+                    ConvexOverlap& out, bool with_energy, std::uint32_t inner = 0);
 
 // A side line of Q (0 <= line < nq) or of P (nq <= line < nq + np) with the other polygon
 // wholly outside it: the two are apart. separating_line returns the first such line or -1.
@@ -180,8 +195,16 @@ class RigidContact {
   // Each outline vertex's displacement (disp_) with the bodies at the poses (ux, uy, theta).
   void displace_pieces(const Model& model, const std::vector<double>& ux,
                        const std::vector<double>& uy, const std::vector<double>& theta);
+  void displace_live_pieces(const Model& model);
+  void overlap_pieces(bool energy);
   double piece_gap(Index i, Index j) const;
-  bool evaluate(std::size_t p, const Model& model, double dt, bool energy, PairOut& out);
+  std::uint32_t inner_lines(const Model& model, const std::vector<double>& ux,
+                            const std::vector<double>& uy, Index i, Index j) const;
+  // The bodies' centroids and half-step velocities, as the pair loop reads them.
+  struct BodyView {
+    const double *cx, *cy, *vx, *vy, *omega;
+  };
+  bool evaluate(std::size_t p, const BodyView& bodies, double dt, bool energy, PairOut& out);
   void pair_constants(const Model& model);
 
   // Parameters.
@@ -192,14 +215,21 @@ class RigidContact {
 
   // Convex pieces: piece k has vertices [piece_first_[k], piece_first_[k + 1]) of ref_, their
   // reference positions as the model gives them; block b has pieces [block_piece_[b],
-  // block_piece_[b + 1]).
-  std::vector<Index> piece_first_, block_piece_;
+  // block_piece_[b + 1]); piece k belongs to block piece_block_[k].
+  std::vector<Index> piece_first_, block_piece_, piece_block_;
   std::vector<Vec2> ref_;
   // Current configuration (free blocks rewritten each step): each vertex's displacement from
   // its reference position.
   std::vector<Vec2> disp_;
+  // The pieces of the live pairs (below) on bodies with a pose, ascending, which the steps
+  // displace; each vertex's offset from its body's reference centroid (set for those pieces).
+  std::vector<Index> moving_pieces_;
+  std::vector<Vec2> offset_;
   // Per block: farthest outline point from the reference centroid [m], longest side [m].
   std::vector<double> radius_, longest_side_;
+  // Per block: 1 when it has a pose of its own (a free body, or a support that moves), as at the
+  // last detection.
+  std::vector<std::uint8_t> moves_;
   // Joints between block pairs (model.joints), for the pair constants.
   struct JointInfo {
     Index a, b;  // a < b
@@ -221,6 +251,11 @@ class RigidContact {
   std::vector<double> slip_x_, slip_y_;   // friction state [m]
   std::vector<std::uint8_t> touched_;     // 1 when the pair touched at the last step
   std::vector<double> last_w_;            // 4 per pair: F_x, F_y, M_b, M_a of the last step
+  // Scratch of add_forces: each pair's joint energy and friction spring energy of the step [J],
+  // and the overlap of each live pair of pieces (overlap_on_ 1 when they overlap).
+  std::vector<double> pair_energy_, pair_stored_;
+  std::vector<ConvexOverlap> overlap_;
+  std::vector<std::uint8_t> overlap_on_;
   // The pairs of convex pieces of each candidate pair that were within the buffer at the
   // detection (pair p's: [live_first_[p], live_first_[p + 1]) of live_i_, live_j_), and for
   // each a side line that separated them at the last evaluation, or -1 (separated_by's
@@ -228,6 +263,10 @@ class RigidContact {
   // not state: it only skips work whose answer is "apart".
   std::vector<Index> live_first_, live_i_, live_j_;
   std::vector<std::int16_t> apart_line_;
+  // For each such pair of pieces, the side lines of its second piece that keep the first wholly
+  // on their inner side until the next detection (convex_overlap's `inner`; "Lines that cannot
+  // cut" above).
+  std::vector<std::uint32_t> inner_;
 
   // Ledger: per body (3 values: x, y, rotation) the dashpot and friction forces of this and of
   // the last step.

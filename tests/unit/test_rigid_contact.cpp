@@ -129,6 +129,29 @@ TEST(RigidContact, ApartPolygonsHaveASeparatingLine) {
   EXPECT_EQ(separating_line(p.data(), 4, touching.data(), 4), -1);
 }
 
+// Skipping a side line of Q that leaves P whole (convex_overlap's `inner`, certified by the
+// contact stage at detection) gives the same overlap to the bit: a block pressed into a tilted
+// joint, with displacements, Q's far side (line 2, from q[2] to q[3]) skipped.
+TEST(RigidContact, SkippedInnerLineChangesNothing) {
+  const std::vector<Vec2> p = box(0, 0, 1, 1);
+  const std::vector<Vec2> q = {{0.1, 0.99}, {0.9, 0.995}, {0.9, 2.0}, {0.1, 2.0}};
+  const std::vector<Vec2> pu = {{1e-7, -2e-8}, {1e-7, -2e-8}, {1e-7, -2e-8}, {1e-7, -2e-8}};
+  const std::vector<Vec2> qu = {{-3e-8, 5e-8}, {-3e-8, 5e-8}, {-3e-8, 5e-8}, {-3e-8, 5e-8}};
+  ConvexOverlap all, skipped;
+  ASSERT_TRUE(convex_overlap(p.data(), pu.data(), 4, q.data(), qu.data(), 4, all, true));
+  ASSERT_TRUE(
+      convex_overlap(p.data(), pu.data(), 4, q.data(), qu.data(), 4, skipped, true, 1u << 2));
+  EXPECT_EQ(all.area, skipped.area);
+  EXPECT_EQ(all.centroid.x, skipped.centroid.x);
+  EXPECT_EQ(all.centroid.y, skipped.centroid.y);
+  EXPECT_EQ(all.normal.x, skipped.normal.x);
+  EXPECT_EQ(all.normal.y, skipped.normal.y);
+  EXPECT_EQ(all.chord, skipped.chord);
+  EXPECT_EQ(all.chord_mid.x, skipped.chord_mid.x);
+  EXPECT_EQ(all.chord_mid.y, skipped.chord_mid.y);
+  EXPECT_EQ(all.depth_sq, skipped.depth_sq);
+}
+
 // A non-convex block (a portal: two legs 0.3 m wide under a 0.5 m lintel) settles on its legs
 // by weight / (kn x 0.6 m2) and stays level, the ledger closed.
 TEST(RigidContact, NonConvexBlockRestsOnBothLegs) {
