@@ -74,7 +74,7 @@ constexpr double kClearanceFloorFraction = 1e-6;
 // Candidate pairs from which on the skip is used. Below, its bookkeeping (the blocks' motion
 // each step, the separations) costs about what it saves: on the 13-block semicircular arch
 // (82 candidates) +1.4% instructions per step, on church B (3300 candidates, 2450 of them
-// skipped) -13% (callgrind, docs/benchmarks.md).
+// skipped) -13% (callgrind; docs/performance.md).
 constexpr std::size_t kSkinPairs = 512;
 // Rejections of a pair without clearance before its separation is measured again.
 constexpr std::uint8_t kRemeasureAfter = 15;

@@ -29,7 +29,7 @@
 // free block's alone against a support with no outline). Why the joint's length and not the
 // blocks' length l normal to the joint (E / l, UDEC practice, which lumps the blocks' uniform
 // compression into the joints so that a column of rigid blocks is as stiff as the elastic
-// one; our default until session 10): what decides lambda* is the hinge, and a hinge does
+// one; rejected): what decides lambda* is the hinge, and a hinge does
 // not compress a block uniformly. The thrust N crowds into a contact zone of width c at the
 // pivot; on a joint of stiffness kn rotating by theta, N = kn theta c^2 / 2, so
 //     c / L = sqrt(2 N / (theta kn L^2)) ~ sqrt(sigma / (theta kn L)),    sigma = N / L,
@@ -70,7 +70,7 @@
 // checkpoints. Its work is booked by the trapezoid over each position increment,
 // 1/2 (f_d^n + f_d^(n-1)) . (x^n - x^(n-1)), per node (contact/contact.cpp), so the ledger
 // stays exact to O(dt^2).
-// Replaced (session 9): the same beta on the rate of the pair's force magnitude, along the
+// Rejected: the same beta on the rate of the pair's force magnitude, along the
 // force, d|f|/dt f / |f|. It left the rocking of a block on its joint undamped: a block
 // rocking onto its corner kept 0.968 of its angular velocity at e = 0 (Housner: 0.912; now
 // 0.941), and the sliding semicircular arch of the regression, whose joints chatter, gave

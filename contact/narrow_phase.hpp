@@ -61,14 +61,14 @@
 // Tried and replaced (same forces to round-off, measured with callgrind on one strip-shaped
 // overlap): splitting P into the three sub-triangle regions by clipping for every integral
 // (~3000 instructions per pair) and a fan of signed triangles from G cut at the sub-triangle
-// lines (~3150), against ~2060 for the envelope form that followed (sessions 2 to 17): by
+// lines (~3150), against ~2060 for an envelope form: by
 // the divergence theorem int_P grad phi (x) (1, x, y) dA became integrals of phi along the
 // edges of P lying on the other triangle, where phi = 3 min lambda is the lower envelope of
 // three lines, integrated piece by piece, and Phi came from the divergence theorem about a
-// point on an edge line of T. On church B (session 18) the pieces above take 1962
+// point on an edge line of T. On church B the pieces above take 1962
 // instructions per touching pair against 2313 for the envelope form: the envelope
-// integrals cost more than the one clip of each small corner sliver (docs/benchmarks.md,
-// "Session 18"). The first Phi, (oint phi (x - G) . n ds + A_P) / 3 with G the centroid of
+// integrals cost more than the one clip of each small corner sliver (callgrind). The first
+// Phi, (oint phi (x - G) . n ds + A_P) / 3 with G the centroid of
 // the triangle, subtracted two quantities of the size of the overlap area: for a resting
 // strip ~1e-12 m deep it lost every digit of the energy (negative values;
 // docs/robustness.md section 2).
