@@ -61,12 +61,22 @@ inline constexpr std::size_t kWholeResponse = static_cast<std::size_t>(-1);
 double sdof_peak_displacement(const std::vector<double>& accel, double dt, double period,
                               double zeta, std::size_t from = 0, std::size_t to = kWholeResponse);
 
+// The damping ratio of the codes' elastic spectra (EN 1998-1 3.2.2.2: 5%, eta = 1).
+inline constexpr double kCodeDamping = 0.05;
+
 // Pseudo-acceleration spectrum Sa(T) = (2 pi / T)^2 max|u| at each period [s] (unit of
-// `accel`), damping ratio zeta (0.05 for the 5%-damped spectrum of the codes).
+// `accel`), damping ratio zeta.
 std::vector<double> response_spectrum(const std::vector<double>& accel, double dt,
-                                      const std::vector<double>& periods, double zeta = 0.05);
+                                      const std::vector<double>& periods,
+                                      double zeta = kCodeDamping);
 
 // `count` >= 2 periods from `first` to `last` [s], evenly spaced in log T (both ends included).
 std::vector<double> log_spaced_periods(double first, double last, int count);
+
+// The periods of every spectrum voussoir writes (`pulse --spectrum`, `synth`'s spectra.csv):
+// 100 log-spaced from 0.02 to 4 s, where the EN 1998-1 elastic spectrum is defined.
+inline std::vector<double> written_spectrum_periods() {
+  return log_spaced_periods(0.02, 4.0, 100);
+}
 
 }  // namespace voussoir

@@ -155,7 +155,7 @@ SynthEnvelope make_synth_envelope(double duration) {
 }
 
 std::vector<double> synth_periods(const SynthSettings& settings) {
-  std::vector<double> t = log_spaced_periods(0.02, 4.0, 100);
+  std::vector<double> t = written_spectrum_periods();
   for (double end : {settings.range_lo, settings.range_hi})
     if (std::find(t.begin(), t.end(), end) == t.end()) t.push_back(end);
   std::sort(t.begin(), t.end());

@@ -106,6 +106,8 @@
 #include <optional>
 #include <vector>
 
+#include "core/spectrum.hpp"
+
 namespace voussoir {
 
 // EN 1998-1 Table 3.2 (Type 1) parameters of a ground type.
@@ -147,10 +149,10 @@ SynthEnvelope make_synth_envelope(double duration);
 
 // Settings of the generation. Typical values are the defaults of `voussoir synth`.
 struct SynthSettings {
-  double dt = 0.01;        // sampling interval [s]
-  double duration = 20.0;  // D [s]
-  double damping = 0.05;   // zeta of the spectra
-  double range_lo = 0.05;  // matching and check range [s]
+  double dt = 0.01;               // sampling interval [s]
+  double duration = 20.0;         // D [s]
+  double damping = kCodeDamping;  // zeta of the spectra
+  double range_lo = 0.05;         // matching and check range [s]
   double range_hi = 3.0;
   int max_iterations = 20;  // SIMQKE cycles (header step 4)
   double tolerance = 0.05;  // stop when |Sa / target - 1| <= this over the range

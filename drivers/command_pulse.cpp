@@ -67,21 +67,16 @@ SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {
 
 // --spectrum: the 5%-damped pseudo-acceleration spectrum (core/spectrum.hpp) of the signal the
 // run uses (read, baseline-corrected, band-passed and scaled as make_base_signal gives it), at
-// kSpectrumPeriods periods log-spaced over [kSpectrumFirst, kSpectrumLast] s; CSV period,sa_g.
-constexpr double kSpectrumFirst = 0.02;  // [s]
-constexpr double kSpectrumLast = 4.0;    // [s]
-constexpr int kSpectrumPeriods = 100;
-constexpr double kSpectrumDamping = 0.05;
+// the written spectrum periods; CSV period,sa_g.
 
 void write_spectrum(const Config& config, const PulseOptions& opts) {
   const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
   if (signal.kind() == BaseSignal::Kind::None)
     throw DeckError(config.deck_path +
                     ": load.base.signal = \"none\": --spectrum needs a base signal");
-  const std::vector<double> periods =
-      log_spaced_periods(kSpectrumFirst, kSpectrumLast, kSpectrumPeriods);
+  const std::vector<double> periods = written_spectrum_periods();
   const std::vector<double> sa =
-      response_spectrum(signal.samples(), signal.sample_dt(), periods, kSpectrumDamping);
+      response_spectrum(signal.samples(), signal.sample_dt(), periods, kCodeDamping);
   // Under mpirun (pulse --curve) every rank reads and checks the record; rank 0 writes.
   if (!is_dealer_rank()) return;
   const double g = config.load.gravity;
@@ -97,7 +92,7 @@ void write_spectrum(const Config& config, const PulseOptions& opts) {
     if (!csv.flush()) throw OutputError(opts.spectrum + ": cannot write the spectrum CSV");
   }
   std::printf("spectrum (%.0f%% damping) of %s: PGA %.4g g, peak Sa %.4g g at T = %.3g s; %s\n",
-              100.0 * kSpectrumDamping,
+              100.0 * kCodeDamping,
               config.load.base.signal == "file" ? config.load.base.file.c_str()
                                                 : config.load.base.signal.c_str(),
               signal.peak_acceleration() / g, sa[top] / g, periods[top], opts.spectrum.c_str());
@@ -108,9 +103,7 @@ void write_spectrum(const Config& config, const PulseOptions& opts) {
 
 int single_run(const Config& config, const CommonOptions& common, const PulseOptions& opts) {
   const auto wall0 = Clock::now();
-  PulseCriteria crit;
-  crit.settle.limits = common.limits;
-  crit.free_time = opts.free_time;
+  const PulseCriteria crit = pulse_criteria(common.limits, opts.free_time);
   const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
   if (signal.kind() == BaseSignal::Kind::None)
     throw DeckError(config.deck_path +
@@ -246,9 +239,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   if (config.load.base.signal != "windowed_sine" && config.load.base.signal != "sine_pulse")
     throw DeckError(config.deck_path + ": load.base.signal = \"" + config.load.base.signal +
                     "\": pulse --curve needs an analytic pulse (windowed_sine or sine_pulse)");
-  PulseCriteria crit;
-  crit.settle.limits = common.limits;
-  crit.free_time = opts.free_time;
+  const PulseCriteria crit = pulse_criteria(common.limits, opts.free_time);
 
   const bool quiet = common.quiet || !is_dealer_rank();
   const std::optional<TiltingCapacity> capacity =

@@ -27,8 +27,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr double kSpectrumDamping = 0.05;  // Sa(T) of the codes
-
 std::string number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
@@ -58,11 +56,10 @@ Record read_record(const Config& config, const std::string& file, const IdaOptio
   r.pga = as_read.peak_acceleration() / g;
   if (!(r.pga > 0.0))
     throw DeckError(file + ": --records: the record's accelerations are all zero");
-  if (opts.im == "sa") {
-    const BaseSignal unit = make_base_signal(r.base, 1.0, 0.0, g);
+  // Sa(T) / PGA of the record as read: a scaled record scales both alike.
+  if (opts.im == "sa")
     r.ratio =
-        response_spectrum(unit.samples(), unit.sample_dt(), {opts.period}, kSpectrumDamping)[0] / g;
-  }
+        response_spectrum(as_read.samples(), as_read.sample_dt(), {opts.period})[0] / (r.pga * g);
   std::ifstream in(file, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   Fnv f;
@@ -143,9 +140,7 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
   std::vector<Record> records;
   for (const std::string& file : opts.records) records.push_back(read_record(config, file, opts));
 
-  PulseCriteria crit;
-  crit.settle.limits = common.limits;
-  crit.free_time = opts.free_time;
+  const PulseCriteria crit = pulse_criteria(common.limits, opts.free_time);
   const bool quiet = common.quiet || !is_dealer_rank();
   const std::optional<TiltingCapacity> capacity =
       study_capacity(config, crit.settle, opts.lambda_star, opts.points, opts.resume, quiet);
@@ -321,7 +316,7 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
                    {"censored", fit.censored}};
     nlohmann::json j = {{"im", opts.im},
                         {"period", opts.im == "sa" ? opts.period : 0.0},
-                        {"damping", kSpectrumDamping},
+                        {"damping", kCodeDamping},
                         {"records", recs},
                         {"fragility", fragility},
                         {"lambda_star", lambda_star},

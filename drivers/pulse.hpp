@@ -79,6 +79,15 @@ struct PulseCriteria {
   double sample_time = 1e-3;       // [s] between classification samples
 };
 
+// The criteria of a command's pulse runs: the default ones with the engine's limits of the
+// command line and its free time after the signal [s].
+inline PulseCriteria pulse_criteria(const RunLimits& limits, double free_time) {
+  PulseCriteria c;
+  c.settle.limits = limits;
+  c.free_time = free_time;
+  return c;
+}
+
 // A named point whose displacement relative to the table is recorded: the node of `block`
 // nearest to the reference position (x0, y0).
 struct ControlPoint {
