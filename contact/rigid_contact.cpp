@@ -35,7 +35,10 @@ struct Clipped {
 
 // Clips the convex polygon `in` by the inner side of a line of Q (d: each vertex's signed
 // distance to it times the side's length, >= 0 inside) into `out` (Sutherland and Hodgman with
-// the edge labels of rigid_contact.hpp).
+// the edge labels of rigid_contact.hpp). Rejected: a form without branches (every vertex
+// writes its crossing and itself to the next slot, the count advanced by what it keeps); it
+// halved the mispredicted jumps that valgrind's model counts on church B but ran its steps 14%
+// slower (13% more instructions).
 inline void clip_by_line(const Clipped& in, const double* d, Clipped& out) {
   int m = 0;
   std::uint64_t on = 0;
@@ -799,6 +802,8 @@ void RigidContact::overlap_pieces(bool energy) {
     std::int16_t& apart = apart_line_[live];
     overlap_on_[live] = 0;
     if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
+    // (Rejected: the vertex counts of two quadrilaterals, every piece pair of the churches, as
+    // constants for the compiler to unroll: no faster.)
     if (!overlap_of(pv, pu, np, qv, qu, nq, overlap_[live], energy, inner_[live])) {
       apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
       continue;
