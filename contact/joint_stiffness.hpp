@@ -1,5 +1,5 @@
 #pragma once
-// Joint stiffness in engineering units and impact damping (issue 23; SPEC section 1 and the
+// Joint stiffness in engineering units and impact damping (SPEC section 1 and the
 // `[contact]` keys normal_stiffness, shear_stiffness, restitution).
 //
 // From kn [N/m3] to a pair penalty. The potential contact force of triangles c and t is

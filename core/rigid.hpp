@@ -1,5 +1,5 @@
 #pragma once
-// Rigid blocks (SPEC section 1, `material.model = "rigid"`; issue 23).
+// Rigid blocks (SPEC section 1, `material.model = "rigid"`; docs/rigid.md).
 //
 // A rigid block is one body: centroid c, rotation theta, velocity v and angular velocity
 // omega. Its outline is what touches (contact/rigid_contact.hpp): the contact stage adds its

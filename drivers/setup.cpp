@@ -85,7 +85,7 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   const double dt_stable = stable_time_step(sim);
   // Infinite when nothing can vibrate (no free block); zero or NaN only when the material,
   // mesh, damping or penalty overflow double precision, and below kMinStableStep only for
-  // absurd values of them (a damping factor of 9e18 gave 1.9e-25 s: fuzzing, issue 8): a
+  // absurd values of them (a damping factor of 9e18 gave 1.9e-25 s, a fuzzing finding): a
   // microsecond of such a run is 1e9 steps. Refused, never run.
   constexpr double kMinStableStep = 1e-15;  // [s]; masonry models sit at 1e-8 to 1e-5 s
   if (!(dt_stable >= kMinStableStep)) {

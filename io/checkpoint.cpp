@@ -126,8 +126,8 @@ std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
   f.value(sim.contact.penalty());
   f.value(sim.contact.buffer());
   f.value(friction);
-  // Rigid blocks and joint stiffness (issue 23): the bodies' mass and inertia, the joints'
-  // stiffness and restitution. Models without them hash as before.
+  // Rigid blocks and joint stiffness: the bodies' mass and inertia, the joints' stiffness and
+  // restitution. Models without them hash without these fields.
   if (m.is_rigid()) {
     f.array(m.rigid.mass);
     f.array(m.rigid.inertia);

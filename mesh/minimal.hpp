@@ -1,5 +1,6 @@
 #pragma once
-// Minimal meshes for rigid blocks (issue 23 item 5; mesh.chord_tolerance).
+// Minimal meshes for rigid blocks (SPEC section 7: no element work where the blocks'
+// deformation does not change the answer; mesh.chord_tolerance).
 //
 // A rigid block needs triangles only for its contact geometry: its outline. Each block's
 // outline (as the scene built it, with a point at every mesh node along its sides) is

@@ -46,7 +46,7 @@ constexpr double kFixedCoarsening = 3.0;
 constexpr double kMaxSizeToSpan = 100.0;
 // Smallest support height accepted, as a multiple of the largest span. Lower supports are
 // outlined into ever thinner course slivers (4450 triangles at 0.05 m, 49418 at 1e-4 m, and
-// no end at 1e-6 m: a fuzzing finding, issue 8); no church stands on supports that low.
+// no end at 1e-6 m: a fuzzing finding); no church stands on supports that low.
 constexpr double kMinHeightToSpan = 0.01;
 
 std::string fmt(double v) {
@@ -142,7 +142,7 @@ Scene build_church_scene(const SceneParams& params) {
   if (!(dtheta > 0.0 && dtheta < 0.5 * kPi))
     geometry_error(params, "model.voussoir_angle", mc.voussoir_angle, "expected (0, 90) degrees");
   // Absurd sizes. Supports are outlined at the arches' element size before any triangle
-  // budget can be estimated (mesh/scene.cpp), so a 4.3e9 m outer buttress (fuzzing, issue 8)
+  // budget can be estimated (mesh/scene.cpp), so a 4.3e9 m outer buttress (a fuzzing finding)
   // exhausted memory in the generator. No church has a support or a height of more than
   // kMaxSizeToSpan times its largest span; a thickness that large is no arch either.
   const double span_max = *std::max_element(spans.begin(), spans.end());

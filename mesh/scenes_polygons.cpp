@@ -466,7 +466,7 @@ Scene build_polygons_scene(const SceneParams& params) {
   const double h = element_size(params, reference);
   scene.element_size = h;
   // Refuse too fine a mesh before outlining: every edge is cut at the element size below, so a
-  // mistyped coordinate (2147483648 for 2, fuzzing of issue 8) made billions of boundary points
+  // mistyped coordinate (2147483648 for 2, a fuzzing finding) made billions of boundary points
   // and exhausted memory before mesh_scene's triangle budget could see the areas. Same
   // estimate as there (~5 triangles per size^2), plus one per boundary point.
   double estimate = 0.0;

@@ -1,4 +1,4 @@
-"""Opens a run's .xdmf in ParaView as a user would, with no workaround (issue 26): with the
+"""Opens a run's .xdmf in ParaView as a user would, with no workaround (docs/output.md): with the
 XDMF Reader, Xdmf3ReaderS and Xdmf3ReaderT, by a relative name from another working directory;
 checks every step has a time, the point vectors have 3 components and the stress is named
 scalars; applies Warp By Vector on `displacement` and saves a screenshot (under Xvfb when

@@ -1,9 +1,9 @@
 #pragma once
-// Bad-input fuzzing of the voussoir program (issue 8, item 3): deterministic mutations of the
-// shipped decks (cases/*.toml) and of the polygon and gmsh files of tests/data, fed to
-// `voussoir check` and `voussoir run` in a child process with a wall-clock, CPU and memory
-// limit (tests/unit/subprocess.hpp). Shared by tests/unit/test_fuzz.cpp (the default share)
-// and tests/slow/test_fuzz_slow.cpp (the full set).
+// Bad-input fuzzing of the voussoir program (SPEC section 2, exit statuses): deterministic
+// mutations of the shipped decks (cases/*.toml) and of the polygon and gmsh files of tests/data,
+// fed to `voussoir check` and `voussoir run` in a child process with a wall-clock, CPU and memory
+// limit (tests/unit/subprocess.hpp). Shared by tests/unit/test_fuzz.cpp (the default share) and
+// tests/slow/test_fuzz_slow.cpp (the full set).
 //
 // Contract checked for every input (SPEC.md section 2, exit status):
 //   check: exit 0, or exit 2 with a "voussoir: error:" message;

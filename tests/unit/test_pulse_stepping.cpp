@@ -14,7 +14,7 @@
 //   - overturning without any impact (mode 1) from A_1, which no impact law changes.
 // voussoir's joint (penalty springs with a restitution dashpot) dissipates at impact a little
 // less than Housner's plastic impact r_H = 1 - 1.5 sin^2(alpha): its ratio lies within the 5%
-// of r_H that issue 23 allows (docs/rigid.md, Rigid.RockingBlockImpactConvergesAsTheJoint
+// of r_H that the rigid tests allow (docs/rigid.md, Rigid.RockingBlockImpactConvergesAsTheJoint
 // Stiffens: 0.941 of the angular velocity kept against Housner's 0.912 on a 0.25 x 1 block),
 // so its mode-2 onset must lie in [A_2(1), A_2(r_H)].
 //

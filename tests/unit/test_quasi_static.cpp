@@ -1,10 +1,10 @@
-// Quasi-static decisions of `capacity` and `sweep` (issue 24, docs/capacity.md): Cundall's
-// local damping (core/integrate.hpp LocalDamping) against its closed form in free fall, its
-// energy booked so that the ledger still closes, a disturbed block brought to rest, the
-// analytic capacities of the block kept; kinetic damping (core/integrate.hpp KineticDamping):
-// a mechanism never reset, a swing stopped at its equilibrium with the ledger closed, a
-// structure out of balance not held still by its resets; the load
-// direction (`capacity --direction`) against mirror symmetry; bad keys and options refused.
+// Quasi-static decisions of `capacity` and `sweep` (docs/capacity.md, "Quasi-static decisions"):
+// Cundall's local damping (core/integrate.hpp LocalDamping) against its closed form in free fall,
+// its energy booked so that the ledger still closes, a disturbed block brought to rest, the
+// analytic capacities of the block kept; kinetic damping (core/integrate.hpp KineticDamping): a
+// mechanism never reset, a swing stopped at its equilibrium with the ledger closed, a structure out
+// of balance not held still by its resets; the load direction (`capacity --direction`) against
+// mirror symmetry; bad keys and options refused.
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Checkpoint and restart of `voussoir run` (issue 8, item 4; io/checkpoint.hpp): a run
+// Checkpoint and restart of `voussoir run` (docs/robustness.md; io/checkpoint.hpp): a run
 // restarted from a checkpoint ends bit for bit where the uninterrupted run ends -- every node
 // position and velocity, every ledger term, the step and the time -- and writes the same series
 // and summary. Scene: the shipped circular arch on a coarse mesh under lambda = 0.5 (above its

@@ -1,4 +1,4 @@
-// Rigid blocks and joint stiffness (core/rigid.hpp, contact/joint_stiffness.hpp; issue 23):
+// Rigid blocks and joint stiffness (core/rigid.hpp, contact/joint_stiffness.hpp; docs/rigid.md):
 // a block settles by weight / (kn area), shears by force / (ks area), rebounds to e^2 of its
 // drop height, keeps its energy balance (also an arch chattering on frictional joints, and a
 // block rocking onto its joint, whose impact converges as the joint stiffens);
@@ -489,7 +489,7 @@ Rocking rocking_ratios(const std::string& kn) {
 
 }  // namespace
 
-// Issue 23: the angular velocity a rocking block keeps at each impact, at restitution 0, is
+// The angular velocity a rocking block keeps at each impact, at restitution 0, is
 // Housner's 1 - 1.5 sin^2(alpha) (0.912 here) within 5%. The penalty joint's impact is not
 // Housner's instantaneous one at the new corner (the whole base meets the ground at once and
 // the joint acts along it over several steps), so the ratio is not his exactly: it settles

@@ -1,4 +1,4 @@
-// Scene tests (SPEC.md section 3, issue "Scenes"): arch areas against the analytic
+// Scene tests (SPEC.md section 3): arch areas against the analytic
 // centreline length x thickness, the basket crown height, mirror symmetry of every symmetric
 // scene, buttress and church dimensions and block counts, coincident joint faces without
 // overlap, polygon-file and gmsh imports against the built-in block, geometry validation

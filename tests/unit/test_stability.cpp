@@ -1,5 +1,5 @@
-// Stiff and extreme cases (issue 8, SPEC.md section 7 "Numerical stability"): very stiff and
-// very soft blocks, a large contact penalty, sliver triangles, no friction and very high
+// Stiff and extreme cases (SPEC.md section 7 "Numerical stability"; docs/robustness.md): very stiff
+// and very soft blocks, a large contact penalty, sliver triangles, no friction and very high
 // friction, very thin and very thick arches, a large lambda, very light and very heavy blocks.
 // Each case runs from rest with the automatic time step and asserts:
 //   - no NaN or infinity anywhere (node positions, velocities, forces, every ledger term) at
@@ -45,7 +45,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kEnergyTolerance = 0.01;  // issue 8: balance error below 1% of peak energy
+constexpr double kEnergyTolerance = 0.01;  // balance error below 1% of peak energy
 constexpr double kG = 9.81;
 
 // Outcome thresholds, on the rigid-body reading of the blocks (drivers/kinematics.hpp) with

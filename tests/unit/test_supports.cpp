@@ -1,7 +1,7 @@
 // Supports that move ([supports], core/supports.hpp): the ramp, moved rigid and elastic
 // supports reaching their pose exactly with the energy ledger balanced, the deck's refusals
 // (exit status 2 naming key and value), model.fixed on generated scenes, limit analysis of the
-// moved blocks, the acceptance of issue 45 (the semicircular arch, rigid blocks, with its
+// moved blocks, the supports' acceptance check (the semicircular arch, rigid blocks, with its
 // supports spread apart carries the least thrust of limit analysis, pushed together the
 // greatest), and the spreading study (drivers/spread.hpp) and its command.
 
@@ -143,10 +143,10 @@ double springing_thrust(const SettledState& s) {
   return support_thrust(m, joint_resultants(m, s.sim.contact, s.sim.ctx.dt)).mean();
 }
 
-// Issue 45's acceptance: spread apart by 1 mm each (0.09% of the 2.2 m span), the arch forms
-// its three hinges and its thrust falls to the least thrust; pushed together it rises to the
-// greatest (here friction at the horizontal springings, mu = 0.6, bounds it: the LP has the
-// same friction). Quasi-static settle and movement, as `capacity` runs them.
+// The supports' acceptance check (docs/supports.md): spread apart by 1 mm each (0.09% of the 2.2 m
+// span), the arch forms its three hinges and its thrust falls to the least thrust; pushed together
+// it rises to the greatest (here friction at the horizontal springings, mu = 0.6, bounds it: the LP
+// has the same friction). Quasi-static settle and movement, as `capacity` runs them.
 TEST(SupportsAcceptance, SpreadArchCarriesTheLeastThrustPushedTheGreatest) {
   TrialCriteria crit;
   crit.quasi_static = true;

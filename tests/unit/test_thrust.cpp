@@ -1,8 +1,8 @@
-// Joint resultants (drivers/thrust.hpp; issue 20's statics checks): a block on a ground carries
-// its weight through the joint's middle; under lambda g the centre of pressure moves by
-// lambda (h/2) W / N towards the toe; the semicircular arch under gravity keeps every centre
-// of pressure inside its joints and its springings carry its weight; at the collapsed trial of
-// its capacity search the hinge joints have their centre of pressure at an edge. Rigid blocks
+// Joint resultants (drivers/thrust.hpp; the statics checks of docs/thrust.md): a block on a ground
+// carries its weight through the joint's middle; under lambda g the centre of pressure moves by
+// lambda (h/2) W / N towards the toe; the semicircular arch under gravity keeps every centre of
+// pressure inside its joints and its springings carry its weight; at the collapsed trial of its
+// capacity search the hinge joints have their centre of pressure at an edge. Rigid blocks
 // (material.model = "rigid") keep these fast.
 
 #include <gtest/gtest.h>

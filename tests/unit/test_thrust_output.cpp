@@ -1,4 +1,4 @@
-// The line of thrust in the outputs (issue 20; docs/thrust.md): the joint resultants of every
+// The line of thrust in the outputs (docs/thrust.md): the joint resultants of every
 // snapshot of `voussoir run`'s HDF5 file are those of `run --json` at the final snapshot,
 // value for value; RunWriter refuses a non-finite resultant other than an open joint's;
 // `voussoir capacity --movie` writes a GIF of the collapsed trial (scripts/animate, matplotlib
