@@ -7,7 +7,9 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,33 @@
 #include "voussoir/config.hpp"
 
 namespace {
+
+// The folders of the output files named on the command line, created before the command
+// runs: a missing folder then neither fails a search at its end, with its results lost, nor
+// asks for a `mkdir` first. A folder that cannot be made is bad input (exit 2) naming the
+// option and the path. Options whose value is a file written by the command; synth's
+// --spectrum names a spectrum, pulse's a CSV.
+void make_output_folders(const CLI::App& cmd) {
+  static const std::set<std::string> kFiles = {
+      "--json",     "--mesh-out", "--output",       "--checkpoint",    "--picture",
+      "--mode-out", "--movie",    "--csv",          "--mechanism-out", "--series",
+      "--plot",     "--resume",   "--spectrum-plot"};
+  for (const CLI::Option* opt : cmd.get_options()) {
+    const std::string name = opt->get_name();
+    const bool file = kFiles.count(name) > 0 || (name == "--spectrum" && cmd.get_name() == "pulse");
+    if (!file || opt->count() == 0) continue;
+    for (const std::string& value : opt->results()) {
+      if (value.empty() || value == "-") continue;
+      const std::filesystem::path folder = std::filesystem::path(value).parent_path();
+      if (folder.empty()) continue;
+      std::error_code ec;
+      std::filesystem::create_directories(folder, ec);
+      if (!std::filesystem::is_directory(folder))  // another rank may have made it meanwhile
+        throw voussoir::DeckError(name + " " + value + ": cannot create the folder " +
+                                  folder.string() + (ec ? ": " + ec.message() : ""));
+    }
+  }
+}
 
 struct DeckArgs {
   std::string deck;
@@ -389,6 +418,7 @@ int main(int argc, char** argv) {
     const bool dealt = sweep->parsed() || stability->parsed() || ida->parsed() ||
                        (pulse->parsed() && pulse_opts.curve);
     if (!dealt && !speaks) return 0;
+    for (const CLI::App* cmd : app.get_subcommands()) make_output_folders(*cmd);
     if (keys->parsed()) {
       std::fputs(voussoir::deck_reference_markdown().c_str(), stdout);
       return 0;

@@ -501,25 +501,66 @@ TEST(DeckErrors, MissingOrUnreadableFile) {
 
 // ---- the real program -----------------------------------------------------------------------
 
+struct ProgramResult {
+  int status = -1;  // exit status, -1 when the program did not exit
+  std::string out;  // stdout and stderr
+};
+
+// Runs the program with `args` (shell words, quoted by the caller).
+ProgramResult run_program(const std::string& args) {
+  ProgramResult r;
+  const std::string cmd = std::string("'") + VOUSSOIR_BINARY + "' " + args + " 2>&1";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return r;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, pipe) != nullptr) r.out += buf;
+  const int status = ::pclose(pipe);
+  if (WIFEXITED(status)) r.status = WEXITSTATUS(status);
+  return r;
+}
+
 TEST(DeckProgram, CheckRefusesBadDeckWithStatus2AndOneLine) {
   if (!fs::exists(VOUSSOIR_BINARY)) GTEST_SKIP() << "no program at " << VOUSSOIR_BINARY;
   const fs::path dir = scratch_dir();
   const fs::path deck = dir / "bad.toml";
   write_file(deck, "[model]\nkind = \"circular_arch\"\n[contact]\nfrictoin = 0.6\n");
-  const std::string cmd =
-      std::string("'") + VOUSSOIR_BINARY + "' check '" + deck.string() + "' 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string out;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, pipe) != nullptr) out += buf;
-  const int status = ::pclose(pipe);
-  ASSERT_TRUE(WIFEXITED(status)) << out;
-  EXPECT_EQ(WEXITSTATUS(status), 2) << out;
+  const ProgramResult r = run_program("check '" + deck.string() + "'");
+  const std::string& out = r.out;
+  EXPECT_EQ(r.status, 2) << out;
   EXPECT_NE(out.find("contact.frictoin"), std::string::npos) << out;
   EXPECT_NE(out.find("contact.friction"), std::string::npos) << out;
   ASSERT_FALSE(out.empty());
   EXPECT_EQ(out.find('\n'), out.size() - 1) << "more than one line:\n" << out;
+  fs::remove_all(dir);
+}
+
+// Output files named on the command line get their folders before the command runs.
+TEST(DeckProgram, OutputFoldersAreMadeBeforeTheCommandRuns) {
+  if (!fs::exists(VOUSSOIR_BINARY)) GTEST_SKIP() << "no program at " << VOUSSOIR_BINARY;
+  const fs::path dir = scratch_dir();
+  const fs::path mesh = dir / "a" / "b" / "mesh.json", json = dir / "c" / "check.json";
+  const ProgramResult r =
+      run_program("check '" + std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml' --mesh-out '" +
+                  mesh.string() + "' --json '" + json.string() + "'");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::is_regular_file(mesh)) << r.out;
+  EXPECT_TRUE(fs::is_regular_file(json)) << r.out;
+  fs::remove_all(dir);
+}
+
+// A folder that cannot be made (a file stands in its place) is bad input, refused at once
+// naming the option and the path.
+TEST(DeckProgram, OutputFolderThatCannotBeMadeIsBadInput) {
+  if (!fs::exists(VOUSSOIR_BINARY)) GTEST_SKIP() << "no program at " << VOUSSOIR_BINARY;
+  const fs::path dir = scratch_dir();
+  write_file(dir / "taken", "a file, not a folder\n");
+  const fs::path picture = dir / "taken" / "arch.png";
+  const ProgramResult r =
+      run_program("capacity '" + std::string(VOUSSOIR_SOURCE_DIR) +
+                  "/cases/circular_arch.toml' --quiet --picture '" + picture.string() + "'");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("--picture " + picture.string()), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("lambda*"), std::string::npos) << "the search ran:\n" << r.out;
   fs::remove_all(dir);
 }
 

@@ -55,7 +55,9 @@ std::vector<T> read_dataset(hid_t file, const std::string& name, hid_t type,
   std::size_t n = 1;
   for (hsize_t s : shape) n *= s;
   std::vector<T> out(n);
-  if (n > 0) EXPECT_GE(H5Dread(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), 0) << name;
+  if (n > 0) {
+    EXPECT_GE(H5Dread(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), 0) << name;
+  }
   H5Dclose(d);
   if (dims) *dims = shape;
   return out;
