@@ -15,8 +15,8 @@
 // voussoir's joint (penalty springs with a restitution dashpot) dissipates at impact a little
 // less than Housner's plastic impact r_H = 1 - 1.5 sin^2(alpha): its ratio lies within the 5%
 // of r_H that the rigid tests allow (docs/rigid.md, Rigid.RockingBlockImpactConvergesAsTheJoint
-// Stiffens: 0.941 of the angular velocity kept against Housner's 0.912 on a 0.25 x 1 block),
-// so its mode-2 onset must lie in [A_2(1), A_2(r_H)].
+// Stiffens: 0.945 to 0.949 of the angular velocity kept against Housner's 0.912 on a 0.25 x 1
+// block), so its mode-2 onset must lie in [A_2(1), A_2(r_H)].
 //
 // Checks: stepping from 1.2 g in 8% steps finds the mode-2 onset inside that interval, and its
 // steps past the first collapse report survivals inside the band below A_1 that Housner's
@@ -24,9 +24,8 @@
 // collapse; the single bisection
 // started inside the band jumps over the mode-2 collapses and lands on A_1 (within 5%: joint
 // compliance, kn = 1e10 N/m3). And exit status 2 for a start, step or frequency that is zero or
-// negative. Measured (the dashpot on the nodal forces' rates): stepping A_c =
-// 1.665 g (ODE interval [1.45, 1.86]), survived at 2.798 and 3.022 g (the ODE survives 2.798 g
-// at r <= 0.92 and 3.022 g at r <= 0.96; r_H = 0.942); about 2 s in all.
+// negative. The values found (stepping A_c, the survivals above it, the bisection's A_1) are in
+// docs/dynamics.md, "The failure curve"; about 2.5 s in all.
 
 #include <gtest/gtest.h>
 
