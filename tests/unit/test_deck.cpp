@@ -3,7 +3,6 @@
 // real program turns a bad deck into exit status 2 with that line.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <toml++/toml.h>
 #include <unistd.h>
 
@@ -16,6 +15,7 @@
 #include <vector>
 
 #include "io/deck.hpp"
+#include "subprocess.hpp"
 
 namespace voussoir {
 namespace {
@@ -501,22 +501,17 @@ TEST(DeckErrors, MissingOrUnreadableFile) {
 
 // ---- the real program -----------------------------------------------------------------------
 
+// The program run on `args` (after the program's path) with the test's default limits; its
+// standard output and error joined, as a user's terminal shows them.
 struct ProgramResult {
   int status = -1;  // exit status, -1 when the program did not exit
-  std::string out;  // stdout and stderr
+  std::string out;  // standard output then standard error
 };
 
-// Runs the program with `args` (shell words, quoted by the caller).
-ProgramResult run_program(const std::string& args) {
-  ProgramResult r;
-  const std::string cmd = std::string("'") + VOUSSOIR_BINARY + "' " + args + " 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, pipe) != nullptr) r.out += buf;
-  const int status = ::pclose(pipe);
-  if (WIFEXITED(status)) r.status = WEXITSTATUS(status);
-  return r;
+ProgramResult run_program(const fs::path& dir, std::vector<std::string> args) {
+  args.insert(args.begin(), VOUSSOIR_BINARY);
+  const testing::ProcessResult p = testing::run_process(args, {}, (dir / "child").string());
+  return {p.exited ? p.status : -1, p.out + p.err};
 }
 
 TEST(DeckProgram, CheckRefusesBadDeckWithStatus2AndOneLine) {
@@ -524,7 +519,7 @@ TEST(DeckProgram, CheckRefusesBadDeckWithStatus2AndOneLine) {
   const fs::path dir = scratch_dir();
   const fs::path deck = dir / "bad.toml";
   write_file(deck, "[model]\nkind = \"circular_arch\"\n[contact]\nfrictoin = 0.6\n");
-  const ProgramResult r = run_program("check '" + deck.string() + "'");
+  const ProgramResult r = run_program(dir, {"check", deck.string()});
   const std::string& out = r.out;
   EXPECT_EQ(r.status, 2) << out;
   EXPECT_NE(out.find("contact.frictoin"), std::string::npos) << out;
@@ -540,8 +535,8 @@ TEST(DeckProgram, OutputFoldersAreMadeBeforeTheCommandRuns) {
   const fs::path dir = scratch_dir();
   const fs::path mesh = dir / "a" / "b" / "mesh.json", json = dir / "c" / "check.json";
   const ProgramResult r =
-      run_program("check '" + std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml' --mesh-out '" +
-                  mesh.string() + "' --json '" + json.string() + "'");
+      run_program(dir, {"check", std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml",
+                        "--mesh-out", mesh.string(), "--json", json.string()});
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(fs::is_regular_file(mesh)) << r.out;
   EXPECT_TRUE(fs::is_regular_file(json)) << r.out;
@@ -556,8 +551,8 @@ TEST(DeckProgram, OutputFolderThatCannotBeMadeIsBadInput) {
   write_file(dir / "taken", "a file, not a folder\n");
   const fs::path picture = dir / "taken" / "arch.png";
   const ProgramResult r =
-      run_program("capacity '" + std::string(VOUSSOIR_SOURCE_DIR) +
-                  "/cases/circular_arch.toml' --quiet --picture '" + picture.string() + "'");
+      run_program(dir, {"capacity", std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml",
+                        "--quiet", "--picture", picture.string()});
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("--picture " + picture.string()), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("lambda*"), std::string::npos) << "the search ran:\n" << r.out;
