@@ -22,6 +22,7 @@
 
 #include "core/fragility.hpp"
 #include "core/spectrum.hpp"
+#include "slender_block.hpp"
 #include "subprocess.hpp"
 
 namespace voussoir {
@@ -197,24 +198,11 @@ std::string write_record(int k) {
   return path;
 }
 
-// The slender rigid block of tests/unit/test_pulse_stepping.cpp (0.2 x 1 m, stiff joints,
-// full impact damping), tilting capacity about b/h = 0.2.
+// The slender rigid block (slender_block.hpp: 0.2 x 1 m, stiff joints, full impact damping),
+// its tilting capacity given as b/h = 0.2.
 std::vector<std::string> block_args(const std::vector<std::string>& extra) {
-  std::vector<std::string> args = {VOUSSOIR_BINARY,
-                                   "ida",
-                                   std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml",
-                                   "--set",
-                                   "model.width=0.2",
-                                   "--set",
-                                   "material.model=\"rigid\"",
-                                   "--set",
-                                   "contact.normal_stiffness=1e10",
-                                   "--set",
-                                   "contact.shear_stiffness=1e10",
-                                   "--set",
-                                   "contact.restitution=0",
-                                   "--lambda-star",
-                                   "0.2"};
+  std::vector<std::string> args = testing::slender_block_args("ida");
+  args.insert(args.end(), {"--lambda-star", "0.2"});
   args.insert(args.end(), extra.begin(), extra.end());
   return args;
 }

@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "slender_block.hpp"
 #include "subprocess.hpp"
 
 namespace {
@@ -103,33 +104,11 @@ double first_amplitude(Pred falls) {
 
 // The rigid slender block with stiff joints and the full impact damping of the dashpot.
 std::vector<std::string> block_curve_args(const std::string& json) {
-  return {VOUSSOIR_BINARY,
-          "pulse",
-          std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml",
-          "-q",
-          "--set",
-          "model.width=0.2",
-          "--set",
-          "material.model=\"rigid\"",
-          "--set",
-          "contact.normal_stiffness=1e10",
-          "--set",
-          "contact.shear_stiffness=1e10",
-          "--set",
-          "contact.restitution=0",
-          "--set",
-          "load.base.signal=\"sine_pulse\"",
-          "--curve",
-          "--freqs",
-          "5",
-          "--lambda-star",
-          "0.2",
-          "--threads",
-          "1",
-          "--csv",
-          json + ".csv",
-          "--json",
-          json};
+  std::vector<std::string> args = voussoir::testing::slender_block_args("pulse");
+  args.insert(args.end(), {"-q", "--set", "load.base.signal=\"sine_pulse\"", "--curve", "--freqs",
+                           "5", "--lambda-star", "0.2", "--threads", "1", "--csv", json + ".csv",
+                           "--json", json});
+  return args;
 }
 
 nlohmann::json run_curve(const std::string& json, const std::vector<std::string>& extra) {
