@@ -6,6 +6,7 @@
 // deck schema and the error types every layer may throw or catch.
 
 #include <array>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -17,6 +18,14 @@ namespace voussoir {
 struct DeckError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// A number as the error messages of command-line options quote it: printf's %g ("0.1", "-1",
+// "1e-30").
+inline std::string option_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
 
 // A failure during a run (non-finite state, energy blow-up, a limit): exit status 1.
 struct RunError : std::runtime_error {

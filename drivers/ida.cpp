@@ -27,12 +27,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 // A record of the study: its signal as the runs use it and what the search needs of it.
 struct Record {
   std::string file;    // as given on the command line
@@ -101,14 +95,14 @@ void validate_ida_options(const IdaOptions& opts) {
   if (opts.im == "sa" && !opts.period_given)
     throw DeckError("ida --im sa needs --period T (s): the period of Sa(T)");
   if (opts.period_given && !(opts.period > 0.0 && std::isfinite(opts.period)))
-    throw DeckError("ida --period " + number(opts.period) +
+    throw DeckError("ida --period " + option_number(opts.period) +
                     " s is not allowed: the period must be a positive number of seconds");
   if (opts.period_given && opts.im != "sa") throw DeckError("ida --period applies to --im sa only");
   if (opts.start_given && !(opts.start > 0.0 && std::isfinite(opts.start)))
-    throw DeckError("ida --start " + number(opts.start) +
+    throw DeckError("ida --start " + option_number(opts.start) +
                     " g is not allowed: the first intensity must be a positive number of g");
   if (!(opts.step > 0.0 && std::isfinite(opts.step)))
-    throw DeckError("ida --step " + number(opts.step) +
+    throw DeckError("ida --step " + option_number(opts.step) +
                     " is not allowed: the relative intensity step must be positive (0.1: each "
                     "step 10% above the last)");
   if (opts.steps_above < 0)
@@ -116,16 +110,16 @@ void validate_ida_options(const IdaOptions& opts) {
                     " is not allowed: the number of steps past the first collapse must be 0 or "
                     "more");
   if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
-    throw DeckError("ida --tolerance " + number(opts.tolerance) +
+    throw DeckError("ida --tolerance " + option_number(opts.tolerance) +
                     " is not allowed: the relative bracket width must lie in (0, 1)");
   if (!(opts.free_time > 0.0 && std::isfinite(opts.free_time)))
-    throw DeckError("ida --free-time " + number(opts.free_time) +
+    throw DeckError("ida --free-time " + option_number(opts.free_time) +
                     " s is not allowed: the free motion after the record must be a positive time");
   if (opts.bootstrap < 1)
     throw DeckError("ida --bootstrap " + std::to_string(opts.bootstrap) +
                     " is not allowed: the number of resamples must be 1 or more");
   if (!(opts.confidence > 0.0 && opts.confidence < 1.0))
-    throw DeckError("ida --confidence " + number(opts.confidence) +
+    throw DeckError("ida --confidence " + option_number(opts.confidence) +
                     " is not allowed: the confidence level must lie in (0, 1)");
   if (opts.seed < 0)
     throw DeckError("ida --seed " + std::to_string(opts.seed) +
@@ -244,7 +238,7 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
   }
 
   const std::string im_name =
-      opts.im == "pga" ? std::string("PGA") : "Sa(" + number(opts.period) + " s)";
+      opts.im == "pga" ? std::string("PGA") : "Sa(" + option_number(opts.period) + " s)";
   std::printf("lambda* = %.4f (tilting capacity%s); intensity measure %s%s\n", lambda_star,
               capacity->computed ? ", computed" : ", given", im_name.c_str(),
               opts.im == "sa" ? " (5% damping)" : "");
@@ -275,8 +269,8 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
     std::vector<std::string> args = {opts.csv, runs_csv, "-o", opts.plot, "--im", im_name};
     if (fit.ok)
       for (const std::string& a :
-           {std::string("--median"), number(fit.median), std::string("--beta"), number(fit.beta),
-            std::string("--ci"), number(ci.lo), number(ci.hi)})
+           {std::string("--median"), option_number(fit.median), std::string("--beta"), option_number(fit.beta),
+            std::string("--ci"), option_number(ci.lo), option_number(ci.hi)})
         args.push_back(a);
     draw_with_script("plot_ida", args, opts.plot);
   }

@@ -538,29 +538,24 @@ std::vector<SearchOutcome> deal_searches(
 }
 
 void validate_pulse_options(const PulseOptions& opts) {
-  auto number = [](double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return std::string(buf);
-  };
   if (!(opts.free_time > 0.0 && std::isfinite(opts.free_time)))
-    throw DeckError("pulse --free-time " + number(opts.free_time) +
+    throw DeckError("pulse --free-time " + option_number(opts.free_time) +
                     " s is not allowed: the free motion after the signal must be a positive time");
   if (!opts.curve) return;
   if (opts.freqs.empty()) throw DeckError("pulse --curve needs --freqs F1,F2,... (Hz)");
   for (double f : opts.freqs)
     if (!(f > 0.0) || !std::isfinite(f))
-      throw DeckError("pulse --freqs: frequency " + number(f) +
+      throw DeckError("pulse --freqs: frequency " + option_number(f) +
                       " Hz is not allowed: every frequency must be a positive number of Hz");
   if (opts.search != "step" && opts.search != "bisect")
     throw DeckError("pulse --search \"" + opts.search +
                     "\" is not allowed: use \"step\" (raise the amplitude step by step, the "
                     "default) or \"bisect\"");
   if (opts.start_given && !(opts.start > 0.0 && std::isfinite(opts.start)))
-    throw DeckError("pulse --start " + number(opts.start) +
+    throw DeckError("pulse --start " + option_number(opts.start) +
                     " g is not allowed: the first amplitude must be a positive number of g");
   if (!(opts.step > 0.0 && std::isfinite(opts.step)))
-    throw DeckError("pulse --step " + number(opts.step) +
+    throw DeckError("pulse --step " + option_number(opts.step) +
                     " is not allowed: the relative amplitude step must be positive (0.05: each "
                     "step 5% above the last)");
   if (opts.steps_above < 0)
@@ -568,11 +563,11 @@ void validate_pulse_options(const PulseOptions& opts) {
                     " is not allowed: the number of steps past the first collapse must be 0 or "
                     "more");
   if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
-    throw DeckError("pulse --tolerance " + number(opts.tolerance) +
+    throw DeckError("pulse --tolerance " + option_number(opts.tolerance) +
                     " is not allowed: the relative bracket width must lie in (0, 1)");
   if (opts.tilt_reference_given &&
       !(opts.tilt_reference > 0.0 && std::isfinite(opts.tilt_reference)))
-    throw DeckError("pulse --tilt-reference " + number(opts.tilt_reference) +
+    throw DeckError("pulse --tilt-reference " + option_number(opts.tilt_reference) +
                     " is not allowed: a measured tilting capacity must be a positive number");
 }
 

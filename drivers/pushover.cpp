@@ -55,12 +55,6 @@ double mass_moment_x(const Model& m) {
   return s;
 }
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 }  // namespace
 
 int default_control_block(const Model& m) {
@@ -101,14 +95,14 @@ void validate_pushover(const Model& m, const PushoverSettings& s) {
   }
   auto positive = [](const char* option, double v) {
     if (!(v > 0.0) || !std::isfinite(v))
-      throw DeckError(std::string(option) + " " + number(v) + ": must be a positive finite number");
+      throw DeckError(std::string(option) + " " + option_number(v) + ": must be a positive finite number");
   };
   // NaN: not given, the default.
   if (!std::isnan(s.rate)) positive("--rate", s.rate);
   if (!std::isnan(s.max_displacement)) positive("--max-displacement", s.max_displacement);
   if (!std::isnan(s.servo)) positive("--servo", s.servo);
   if (s.direction != 1.0 && s.direction != -1.0)
-    throw DeckError("--direction " + number(s.direction) + ": must be +x or -x");
+    throw DeckError("--direction " + option_number(s.direction) + ": must be +x or -x");
 }
 
 Sdof equivalent_sdof(const std::vector<double>& weights, const std::vector<double>& dx, int control,
@@ -289,7 +283,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
       if (past_peak && quasi_static && lambda_qs <= 0.0) stop = true, ended = "lambda <= 0";
       if (past_peak && quasi_static && set.stop_fraction > 0.0 &&
           lambda_qs <= set.stop_fraction * peak_lambda && !stop)
-        stop = true, ended = "fallen to " + number(set.stop_fraction) + " x peak";
+        stop = true, ended = "fallen to " + option_number(set.stop_fraction) + " x peak";
       win = Window{d, lambda, s_now, e_rate, run_time};
     }
     // The target: fast while lambda is below kFastFraction lambda_ref, at the rate after.
