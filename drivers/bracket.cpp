@@ -26,13 +26,21 @@ bool narrow_bracket(Bracket& b, const std::vector<double>& probes,
 
 std::vector<double> probes_ahead(const Bracket& b, const std::vector<double>& probes,
                                  const std::vector<Outcome3>& known, double tolerance, int points,
-                                 ProbePlacement placement, int depth, double estimate) {
+                                 ProbePlacement placement, int depth, double estimate,
+                                 const std::map<double, bool>& finished) {
   std::vector<double> ahead;
   Bracket cur = b;
   std::vector<double> round = probes;
   std::vector<Outcome3> outcomes = known;
+  auto result = [&](double p) {
+    const auto it = finished.find(p);
+    return it == finished.end() ? Outcome3::Unknown
+                                : (it->second ? Outcome3::Crossed : Outcome3::NotCrossed);
+  };
   for (int d = 0; d < depth; ++d) {
     const double middle = std::isnan(estimate) ? 0.5 * (cur.lo + cur.hi) : estimate;
+    for (std::size_t i = 0; i < round.size(); ++i)
+      if (outcomes[i] == Outcome3::Unknown) outcomes[i] = result(round[i]);
     std::vector<bool> crossed(round.size());
     for (std::size_t i = 0; i < round.size(); ++i) {
       if (outcomes[i] != Outcome3::Unknown) {
@@ -43,6 +51,10 @@ std::vector<double> probes_ahead(const Bracket& b, const std::vector<double>& pr
       for (std::size_t j = 0; j < round.size(); ++j) {
         below_crossed |= outcomes[j] == Outcome3::Crossed && round[j] < round[i];
         above_uncrossed |= outcomes[j] == Outcome3::NotCrossed && round[j] > round[i];
+      }
+      for (const auto& [l, c] : finished) {
+        below_crossed |= c && l < round[i];
+        above_uncrossed |= !c && l > round[i];
       }
       crossed[i] = below_crossed || (!above_uncrossed && round[i] > middle);
     }

@@ -18,6 +18,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <map>
 #include <vector>
 
 namespace voussoir {
@@ -47,20 +48,23 @@ bool narrow_bracket(Bracket& b, const std::vector<double>& probes,
 enum class Outcome3 : signed char { Unknown = -1, NotCrossed = 0, Crossed = 1 };
 
 // The probes of the rounds after this one, before its outcomes are all known: what idle cores
-// can run ahead (drivers/trial_pool.hpp). Each unknown outcome is guessed -- crossed when a
-// known crossed probe lies below it (it is then ignored by narrow_bracket anyway), not crossed
-// when a known uncrossed probe lies above it (a monotone response), else crossed exactly when
-// it lies above `estimate` (a guess of the threshold; NaN: the middle of each bracket) -- the
-// bracket is narrowed as narrow_bracket would, and the probes of the next round are listed,
-// then those of the round after it with its own probes' outcomes guessed the same way, up to
-// `depth` rounds ahead; nothing past the round after which shrink_bracket would stop. Within a
-// round, the highest probe comes first (near the threshold a collapse starts slowly: the
-// longest trial of its round). With every outcome known, the first `points` probes are
-// exactly the next round's.
+// can run ahead (drivers/trial_pool.hpp). A probe's outcome is taken from `known` (this
+// round's, in the order of `probes`), else from `finished` (every trial that has ended, run
+// ahead or not: lambda -> crossed); one still unknown is guessed -- crossed when a known
+// crossed probe or finished trial lies below it (it is then ignored by narrow_bracket anyway),
+// not crossed when a known uncrossed one lies above it (a monotone response), else crossed
+// exactly when it lies above `estimate` (a guess of the threshold; NaN: the middle of each
+// bracket) -- the bracket is narrowed as narrow_bracket would, and the probes of the next round
+// are listed, then those of the round after it with its own probes' outcomes found or guessed
+// the same way, up to `depth` rounds ahead; nothing past the round after which shrink_bracket
+// would stop. Within a round, the highest probe comes first (near the threshold a collapse
+// starts slowly: the longest trial of its round). With every outcome known, the first `points`
+// probes are exactly the next round's.
 std::vector<double> probes_ahead(const Bracket& b, const std::vector<double>& probes,
                                  const std::vector<Outcome3>& known, double tolerance, int points,
                                  ProbePlacement placement, int depth,
-                                 double estimate = std::numeric_limits<double>::quiet_NaN());
+                                 double estimate = std::numeric_limits<double>::quiet_NaN(),
+                                 const std::map<double, bool>& finished = {});
 
 // Rounds until hi - lo <= tolerance x hi. `run_round(probes)` returns the crossed flags of the
 // probes; `after_round(b)` sees the bracket after each round (progress lines). Returns the

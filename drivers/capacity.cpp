@@ -303,14 +303,12 @@ RunSpec trial_spec(const SettledState& settled, double lambda, const TrialCriter
 }  // namespace
 
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& crit,
-                      bool quiet, const std::atomic<bool>* cancel) {
+                      bool quiet, const std::function<bool(double)>* sample) {
   const auto t0 = Clock::now();
   Simulation sim = settled.sim;  // deep copy
   RunSpec spec = trial_spec(settled, lambda, crit, quiet);
-  if (cancel)
-    spec.on_sample = [cancel](const Simulation&, const Probe&) {
-      return !cancel->load(std::memory_order_relaxed);
-    };
+  if (sample)
+    spec.on_sample = [sample](const Simulation&, const Probe& p) { return (*sample)(p.time); };
   const Outcome o = run_engine(sim, spec);
 
   TrialResult r;
@@ -512,8 +510,8 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   const int workers = omp_in_parallel() ? 1 : std::max(1, omp_get_max_threads());
   TrialPool pool(
       workers,
-      [&](double lambda, const std::atomic<bool>& cancel) {
-        return run_trial(settled, lambda, crit, quiet, &cancel);
+      [&](double lambda, const TrialPool::Sample& sample) {
+        return run_trial(settled, lambda, crit, quiet, &sample);
       },
       [&](const TrialResult& r) { journal.append(trial_json(r)); });
   // Rounds ahead that the planners list (bracket.hpp probes_ahead), and their guess of
@@ -554,11 +552,57 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
   double s_lo = 0.0, s_hi = 0.0;
   bool lo_presumed = false, hi_presumed = false;
 
+  // A contradicted bracket (the seed's, or the deck's) widens geometrically: down from a low
+  // end that collapsed (it becomes hi), up from a high end that stood (it becomes lo; no
+  // collapse up to kCap leaves the search unbracketed).
+  auto widen_down = [&](double from) {
+    hi = from;
+    double down = from;
+    while (down > 1e-3) {
+      ++res.seed.widenings;
+      down *= kWidenDown;
+      if (!quiet)
+        std::fprintf(stderr, "bracket contradicted (collapse at %.5f): widening down\n", hi);
+      if (!evaluate({down})[0].collapsed) {
+        lo = down;
+        return;
+      }
+      hi = down;
+    }
+    lo = 0.0;
+  };
+  auto widen_up = [&](double from) {
+    if (!quiet) std::fprintf(stderr, "bracket contradicted (stable at %.5f): widening up\n", from);
+    lo = from;
+    have_hi = false;
+    double up = from;
+    while (!have_hi && up < kCap) {
+      ++res.seed.widenings;
+      up *= kWidenUp;
+      if (evaluate({up})[0].collapsed) {
+        hi = up;
+        have_hi = true;
+      } else {
+        lo = up;
+      }
+    }
+  };
+
   if (hi > lo) {
-    // The deck's bracket: its upper end is checked (the lower is trusted, 0 by default).
-    const auto round = evaluate({hi});
-    have_hi = round[0].collapsed;
-    if (!have_hi) lo = hi;
+    // The deck's bracket: both ends are run, side by side (a lower end of 0 is not). A lower
+    // end that collapses widens the bracket down; an upper end that stands starts the growth
+    // below from it.
+    std::vector<double> ends;
+    if (lo > 0.0) ends.push_back(lo);
+    ends.push_back(hi);
+    const auto round = evaluate(ends);
+    have_hi = round.back().collapsed;
+    if (lo > 0.0 && round.front().collapsed) {
+      widen_down(lo);
+      have_hi = true;
+    } else if (!have_hi) {
+      lo = hi;
+    }
   } else if (search.seed_from_limit) {
     // Towards -x: limit analysis of the mirror image towards +x.
     const LimitResult la = limit_of_settled(settled, config.contact.friction, crit.direction);
@@ -596,41 +640,6 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
     }
   }
 
-  // A contradicted seed widens geometrically: down from a low end that collapsed (it becomes
-  // hi), up from a high end that stood (it becomes lo; no collapse up to kCap leaves the
-  // search unbracketed).
-  auto widen_down = [&](double from) {
-    hi = from;
-    double down = from;
-    while (down > 1e-3) {
-      ++res.seed.widenings;
-      down *= kWidenDown;
-      if (!quiet) std::fprintf(stderr, "seed contradicted (collapse at %.5f): widening down\n", hi);
-      if (!evaluate({down})[0].collapsed) {
-        lo = down;
-        return;
-      }
-      hi = down;
-    }
-    lo = 0.0;
-  };
-  auto widen_up = [&](double from) {
-    if (!quiet) std::fprintf(stderr, "seed contradicted (stable at %.5f): widening up\n", from);
-    lo = from;
-    have_hi = false;
-    double up = from;
-    while (!have_hi && up < kCap) {
-      ++res.seed.widenings;
-      up *= kWidenUp;
-      if (evaluate({up})[0].collapsed) {
-        hi = up;
-        have_hi = true;
-      } else {
-        lo = up;
-      }
-    }
-  };
-
   // k-section (drivers/bracket.hpp): `points` interior lambdas per round, run in parallel. A
   // presumed seed end that is still an end of the bracket is also listed for idle workers,
   // after the rounds ahead.
@@ -644,9 +653,11 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
           const bool check_lo = lo_presumed && now.lo == s_lo;
           const bool check_hi = hi_presumed && now.hi == s_hi;
           std::vector<bool> collapsed;
-          for (const TrialResult& r : evaluate(lambdas, [=](const std::vector<Outcome3>& known) {
-                 std::vector<double> ahead = probes_ahead(now, lambdas, known, tol, points,
-                                                          ProbePlacement::KSection, depth, guess);
+          for (const TrialResult& r : evaluate(lambdas, [=](const std::vector<Outcome3>&known,
+                                                            const std::map<double, bool>&finished) {
+                 std::vector<double> ahead =
+                     probes_ahead(now, lambdas, known, tol, points, ProbePlacement::KSection, depth,
+                                  guess, finished);
                  if (check_hi) ahead.push_back(s_hi);
                  if (check_lo) ahead.push_back(s_lo);
                  return ahead;

@@ -41,7 +41,6 @@
 // points is fixed, not taken from the thread count, so results do not depend on it. Stops when
 // hi - lo <= tolerance x hi; lambda* = (lo + hi) / 2.
 
-#include <atomic>
 #include <functional>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
@@ -186,9 +185,10 @@ std::string settled_fingerprint(const SettledState& settled, const TrialCriteria
 
 // One trial from a copy of the settled state; unless quiet, a progress line on stderr every
 // kProgressPeriod of wall time.
-// A set `cancel` stops the trial at its next sample (its result is then meaningless).
+// `sample`, if any, is called at every sample with the simulated time reached [s]; false stops
+// the trial there (its result is then meaningless).
 TrialResult run_trial(const SettledState& settled, double lambda, const TrialCriteria& criteria,
-                      bool quiet, const std::atomic<bool>* cancel = nullptr);
+                      bool quiet, const std::function<bool(double)>* sample = nullptr);
 
 // A trial's record: a line of the `--resume` journal, and (without "hinges") an entry of the
 // capacity JSON's "runs"; trial_from_json reads the journal's line back.

@@ -28,7 +28,7 @@ TrialPool::~TrialPool() {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
     for (auto& [lambda, e] : entries_)
-      if (e.state == State::Running) e.cancel->store(true);
+      if (e.state == State::Running) e.live->cancel.store(true);
   }
   changed_.notify_all();
   for (std::thread& t : threads_) t.join();
@@ -74,19 +74,37 @@ bool TrialPool::pick(double& lambda) {
 }
 
 void TrialPool::replan() {
+  auto ended = [](const Entry& e) { return e.state == State::Done && !e.live->cancel.load(); };
+  // Every trial that has ended, and the horizon of the stable ones (trial_pool.hpp).
+  std::map<double, bool> finished;
+  double horizon = -std::numeric_limits<double>::infinity(), highest_stable = horizon;
+  for (const auto& [l, e] : entries_) {
+    if (!ended(e)) continue;
+    finished[l] = e.result.collapsed;
+    if (e.result.collapsed) continue;
+    horizon = std::max(horizon, e.result.sim_time);
+    highest_stable = std::max(highest_stable, l);
+  }
+  if (!(horizon > 0.0)) horizon = std::numeric_limits<double>::infinity();  // none yet
   std::vector<Outcome3> known;
   for (double l : round_) {
     const auto it = entries_.find(l);
-    const bool done =
-        it != entries_.end() && it->second.state == State::Done && !it->second.cancel->load();
-    known.push_back(!done
-                        ? Outcome3::Unknown
-                        : (it->second.result.collapsed ? Outcome3::Crossed : Outcome3::NotCrossed));
+    Outcome3 o = Outcome3::Unknown;
+    if (it != entries_.end() && ended(it->second))
+      o = it->second.result.collapsed ? Outcome3::Crossed : Outcome3::NotCrossed;
+    else if (it != entries_.end() && it->second.state == State::Running && l > highest_stable &&
+             it->second.live->reached.load() > horizon)
+      o = Outcome3::Crossed;  // guessed: running past every stable trial's end
+    known.push_back(o);
   }
-  plan_ = planner_(known);
-  for (auto& [l, e] : entries_)
-    if (e.state == State::Running && !e.asked && !contains(round_, l) && !contains(plan_, l))
-      e.cancel->store(true);
+  plan_ = planner_(known, finished);
+  for (auto& [l, e] : entries_) {
+    if (e.state != State::Running) continue;
+    const bool past = e.live->reached.load() > horizon;
+    const bool may_turn = !past && l > highest_stable && contains(round_, l);
+    e.live->recheck.store(may_turn ? horizon : std::numeric_limits<double>::infinity());
+    if (!e.asked && !contains(round_, l) && !contains(plan_, l)) e.live->cancel.store(true);
+  }
 }
 
 void TrialPool::work() {
@@ -96,13 +114,24 @@ void TrialPool::work() {
     double lambda = 0.0;
     changed_.wait(lock, [&] { return stop_ || pick(lambda); });
     if (stop_) return;
-    const std::shared_ptr<std::atomic<bool>> cancel = entries_.at(lambda).cancel;
+    const std::shared_ptr<Live> live = entries_.at(lambda).live;
     lock.unlock();
+    // A trial that runs past its recheck time makes the plan again (trial_pool.hpp).
+    const Sample sample = [this, live](double t) {
+      live->reached.store(t);
+      if (t > live->recheck.load()) {
+        std::lock_guard<std::mutex> relock(mutex_);
+        live->recheck.store(std::numeric_limits<double>::infinity());
+        replan();
+        changed_.notify_all();
+      }
+      return !live->cancel.load(std::memory_order_relaxed);
+    };
     const auto t0 = std::chrono::steady_clock::now();
     TrialResult r;
     std::exception_ptr error;
     try {
-      r = run_(lambda, *cancel);
+      r = run_(lambda, sample);
     } catch (...) {
       error = std::current_exception();
     }
@@ -110,7 +139,7 @@ void TrialPool::work() {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     lock.lock();
     --running_;
-    if (cancel->load()) {
+    if (live->cancel.load()) {
       ++stats_.cancelled;
       stats_.unused_s += wall;
       entries_.erase(lambda);
@@ -138,7 +167,7 @@ std::vector<TrialResult> TrialPool::run_round(const std::vector<double>& lambdas
         continue;
       }
       try {
-        out[i] = run_(lambdas[i], std::atomic<bool>(false));
+        out[i] = run_(lambdas[i], [](double) { return true; });
         Entry& e = entries_[lambdas[i]];
         e.state = State::Done;
         e.result = out[i];
@@ -155,7 +184,8 @@ std::vector<TrialResult> TrialPool::run_round(const std::vector<double>& lambdas
     for (double l : lambdas) {
       const auto it = entries_.find(l);
       if (it == entries_.end()) continue;
-      if (it->second.ahead && !it->second.asked && !it->second.cancel->load()) ++stats_.ahead_used;
+      if (it->second.ahead && !it->second.asked && !it->second.live->cancel.load())
+        ++stats_.ahead_used;
       it->second.asked = true;
       record(it->second);
     }
@@ -164,7 +194,7 @@ std::vector<TrialResult> TrialPool::run_round(const std::vector<double>& lambdas
     auto ended = [&](double l) {
       const auto it = entries_.find(l);
       return it != entries_.end() && it->second.state != State::Running &&
-             !it->second.cancel->load();
+             !it->second.live->cancel.load();
     };
     changed_.wait(lock, [&] { return std::all_of(lambdas.begin(), lambdas.end(), ended); });
     for (std::size_t i = 0; i < lambdas.size(); ++i) {

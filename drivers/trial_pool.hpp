@@ -7,11 +7,21 @@
 // stable trial of 25 s of wall and a collapse of 50 s), so a core waits idle for half the
 // round. The pool gives such a core the trial the search is most likely to ask for next: the
 // search hands each round a planner (drivers/bracket.hpp probes_ahead: the next rounds' probes
-// with the round's pending outcomes guessed), and a worker with nothing of the round left to
-// start takes the first planned lambda that is neither run nor running. When the search asks
-// for a lambda that was run ahead, it takes the result (or waits for the running trial); a
-// trial run ahead that has dropped out of every plan (a wrong guess) is cancelled at its next
-// sample.
+// with the round's pending outcomes guessed, and every trial that has ended, run ahead or not,
+// taken as it ended), and a worker with nothing of the round left to start takes the first
+// planned lambda that is neither run nor running. When the search asks for a lambda that was
+// run ahead, it takes the result (or waits for the running trial); a trial run ahead that has
+// dropped out of every plan (a wrong guess) is cancelled at its next sample.
+//
+// The pending trials of the round are guessed from how long they have run: one that has run
+// longer in simulated time than every stable trial so far took to end (at rest), above all of
+// them in lambda, is guessed collapsed (a stable trial comes to rest, a collapse near lambda*
+// goes on until the collapse criterion: church B's stable trials end after 0.26 to 0.45 s, its
+// collapsed ones after 0.68 to 0.76 s); the others are guessed by the planner's own rule. Each
+// trial reports the simulated time it has reached at its samples, and the plan is made again
+// when one runs past that horizon, so a core that took a wrong guess is freed at once. (The
+// planner's rule alone, an estimate of lambda* from limit analysis, guessed church B's first
+// collapse stable and ran the wrong round ahead.)
 //
 // What the search sees does not change: each trial's result is a function of its lambda alone
 // (every trial starts from a copy of the same settled state), and the search reads only the
@@ -29,6 +39,7 @@
 #include <condition_variable>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -50,10 +61,14 @@ struct PoolStats {
 
 class TrialPool {
  public:
-  // Runs one trial; stops early (any result, discarded) once `cancel` is set.
-  using Runner = std::function<TrialResult(double lambda, const std::atomic<bool>& cancel)>;
-  // The lambdas to run ahead, best first, from what is known of the round's outcomes.
-  using Planner = std::function<std::vector<double>(const std::vector<Outcome3>& known)>;
+  // At each sample a running trial calls `sample` with the simulated time it has reached [s];
+  // false: stop early (any result, discarded).
+  using Sample = std::function<bool(double sim_time)>;
+  using Runner = std::function<TrialResult(double lambda, const Sample& sample)>;
+  // The lambdas to run ahead, best first, from the round's outcomes (known or guessed, above)
+  // and every trial that has ended (lambda -> collapsed).
+  using Planner = std::function<std::vector<double>(const std::vector<Outcome3>& round,
+                                                    const std::map<double, bool>& finished)>;
   // Called (serialised) once for every trial the search asks for and that ran here, as soon
   // as it has both finished and been asked for: the journal, which so holds only the search's
   // trials, as without the pool.
@@ -71,7 +86,10 @@ class TrialPool {
   // trial, in input order, is rethrown once all have ended.
   std::vector<TrialResult> run_round(const std::vector<double>& lambdas, Planner planner);
   // A planner with nothing ahead.
-  static std::vector<double> nothing_ahead(const std::vector<Outcome3>&) { return {}; }
+  static std::vector<double> nothing_ahead(const std::vector<Outcome3>&,
+                                           const std::map<double, bool>&) {
+    return {};
+  }
 
   // Cancels every trial running ahead and waits for them to stop (the search is over).
   void cancel_ahead();
@@ -80,6 +98,13 @@ class TrialPool {
 
  private:
   enum class State { Running, Done, Failed };
+  // What a running trial and the pool share without the lock.
+  struct Live {
+    std::atomic<bool> cancel{false};
+    std::atomic<double> reached{0.0};  // [s] simulated, at its last sample
+    // [s] past which the trial's guess changes (the horizon above; infinite: it cannot).
+    std::atomic<double> recheck{std::numeric_limits<double>::infinity()};
+  };
   struct Entry {
     State state = State::Running;
     TrialResult result;
@@ -87,13 +112,14 @@ class TrialPool {
     bool asked = false;     // the search asked for it
     bool ahead = false;     // started before it was asked for
     bool recorded = false;  // passed to Finished (or preloaded)
-    std::shared_ptr<std::atomic<bool>> cancel = std::make_shared<std::atomic<bool>>(false);
+    std::shared_ptr<Live> live = std::make_shared<Live>();
   };
 
   void work();
   // Under the lock: the next lambda to start, or false.
   bool pick(double& lambda);
-  // Under the lock: the plan from the round's outcomes; cancels what dropped out of it.
+  // Under the lock: the plan from the round's outcomes, known or guessed; cancels what dropped
+  // out of it and sets each running trial's recheck.
   void replan();
   // Under the lock: passes a finished trial the search asked for to Finished, once; a failure
   // of Finished fails the trial.

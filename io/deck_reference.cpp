@@ -104,7 +104,9 @@ const std::map<std::string, std::string>& meanings() {
        "polynomial removed from the acceleration, fitted to the displacement (docs/records.md)"},
       {"load.base.band", "band-pass filter of the accelerogram [low, high] ([0, 0]: none)"},
       // [capacity]
-      {"capacity.lambda_min", "lower end of the starting bracket of `capacity` (stable)"},
+      {"capacity.lambda_min",
+       "lower end of the starting bracket of `capacity` (stable); above 0, checked by a trial "
+       "beside lambda_max's (a collapse there widens the bracket down)"},
       {"capacity.lambda_max",
        "upper end of the starting bracket (both 0: from limit analysis); checked by a trial"},
       {"capacity.tolerance", "relative width of the final bracket: (hi - lo) / hi"},

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <map>
 #include <vector>
 
 #include "drivers/bracket.hpp"
@@ -103,6 +105,23 @@ TEST(Bracket, ProbesAheadFollowTheSearch) {
   const std::vector<double> second = highest_first({in12[0], in12[1]});
   EXPECT_EQ(two[2], second[0]);
   EXPECT_EQ(two[3], second[1]);
+
+  // Trials that have ended elsewhere (run ahead) are taken as they ended: a collapse at 0.5
+  // makes both pending probes collapse -> [0, 1], against [1, 2] guessed from the middle.
+  EXPECT_EQ(probes_ahead(c, p12, {O::Unknown, O::Unknown}, 1e-3, 2, ProbePlacement::KSection, 1,
+                         std::numeric_limits<double>::quiet_NaN(), {{0.5, true}}),
+            highest_first({0.0, 1.0}));
+  // ... and so are the next round's probes: with 1 and 2 known, [1, 2] is next; both its
+  // probes collapsed, so the round after it is inside [1, in12[0]] (guessed from the middle,
+  // it would be inside [in12[0], in12[1]]).
+  const std::map<double, bool> ran{{in12[0], true}, {in12[1], true}};
+  const std::vector<double> three =
+      probes_ahead(c, p12, {O::NotCrossed, O::Crossed}, 1e-3, 2, ProbePlacement::KSection, 2,
+                   std::numeric_limits<double>::quiet_NaN(), ran);
+  ASSERT_EQ(three.size(), 4u);
+  const std::vector<double> inner = bracket_probes({1.0, in12[0]}, 2, ProbePlacement::KSection);
+  EXPECT_EQ(three[2], inner[1]);
+  EXPECT_EQ(three[3], inner[0]);
 }
 
 }  // namespace

@@ -196,6 +196,43 @@ normal_stiffness = 1e6
   EXPECT_TRUE(hi_ran);
 }
 
+// The deck's bracket (capacity.lambda_min, lambda_max) is run at both ends, side by side: a
+// bracket that holds is searched in, and one whose lower end collapses widens down from it, as
+// a contradicted seed does.
+TEST(Capacity, TheDecksBracketIsRunAtBothEnds) {
+  Config held = block_deck(0.8);
+  held.capacity.lambda_min = 0.45;
+  held.capacity.lambda_max = 0.55;
+  const CapacityResult r = find_capacity(held, TrialCriteria{}, 2, true);
+  ASSERT_TRUE(r.bracketed);
+  ASSERT_GE(r.trials.size(), 2u);
+  EXPECT_EQ(r.trials[0].lambda, 0.45);
+  EXPECT_FALSE(r.trials[0].collapsed);
+  EXPECT_EQ(r.trials[1].lambda, 0.55);
+  EXPECT_TRUE(r.trials[1].collapsed);
+  EXPECT_EQ(r.seed.widenings, 0);
+  EXPECT_NEAR(r.lambda_star, 0.5, 0.005);
+
+  Config above = block_deck(0.8);
+  above.capacity.lambda_min = 0.6;
+  above.capacity.lambda_max = 0.7;
+  const CapacityResult w = find_capacity(above, TrialCriteria{}, 2, true);
+  ASSERT_TRUE(w.bracketed);
+  EXPECT_EQ(w.trials[0].lambda, 0.6);
+  EXPECT_TRUE(w.trials[0].collapsed);
+  EXPECT_GT(w.seed.widenings, 0);
+  EXPECT_LT(w.hi, 0.6);
+  EXPECT_NEAR(w.lambda_star, 0.5, 0.005);
+  for (const TrialResult& t : w.trials) {
+    if (t.lambda <= w.lo) {
+      EXPECT_FALSE(t.collapsed) << t.lambda;
+    }
+    if (t.lambda >= w.hi) {
+      EXPECT_TRUE(t.collapsed) << t.lambda;
+    }
+  }
+}
+
 // The settle under gravity does not read the load direction, so `--direction both` settles
 // once and both searches start from it: towards -x, the search from a settle shared with +x is
 // the search that settles alone, trial for trial and bit for bit.

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -37,18 +38,18 @@ TEST(TrialPool, RunsAheadAndCancelsAWrongGuess) {
   {
     TrialPool pool(
         3,
-        [&](double lambda, const std::atomic<bool>& cancel) {
+        [&](double lambda, const TrialPool::Sample& sample) {
           if (lambda == 5.0) {
             ahead_started = true;
-            while (!cancel.load()) std::this_thread::yield();
+            while (sample(0.0)) std::this_thread::yield();
           }
           if (lambda == 1.0)
             while (!ahead_started.load()) std::this_thread::yield();
           return fake(lambda, 1.5);
         },
         [&](const TrialResult& r) { journal.push_back(r.lambda); });
-    const std::vector<TrialResult> out =
-        pool.run_round({1.0, 2.0}, [](const std::vector<Outcome3>& known) {
+    const std::vector<TrialResult> out = pool.run_round(
+        {1.0, 2.0}, [](const std::vector<Outcome3>& known, const std::map<double, bool>&) {
           const bool pending = known[0] == Outcome3::Unknown || known[1] == Outcome3::Unknown;
           return pending ? std::vector<double>{5.0} : std::vector<double>{};
         });
@@ -73,18 +74,62 @@ TEST(TrialPool, RunsAheadAndCancelsAWrongGuess) {
 TEST(TrialPool, TakesTrialsRunAheadAndRethrowsOnlyAskedFailures) {
   TrialPool pool(
       2,
-      [&](double lambda, const std::atomic<bool>&) {
+      [&](double lambda, const TrialPool::Sample&) {
         if (lambda == 9.0) throw std::runtime_error("trial 9 failed");
         return fake(lambda, 3.5);
       },
       [](const TrialResult&) {});
   // The planner keeps 3 and 9 ahead for as long as this round is the pool's.
-  auto plan = [](const std::vector<Outcome3>&) { return std::vector<double>{3.0, 9.0}; };
+  auto plan = [](const std::vector<Outcome3>&, const std::map<double, bool>&) {
+    return std::vector<double>{3.0, 9.0};
+  };
   EXPECT_EQ(pool.run_round({1.0}, plan).front().lambda, 1.0);
   const std::vector<TrialResult> next = pool.run_round({3.0}, TrialPool::nothing_ahead);
   EXPECT_FALSE(next.front().collapsed);
   EXPECT_THROW(pool.run_round({9.0}, TrialPool::nothing_ahead), std::runtime_error);
   pool.cancel_ahead();
+}
+
+// A pending trial that runs past the simulated time at which the round's stable trial came to
+// rest is guessed collapsed, and the plan is made again at once: two workers, a round {1, 2};
+// 1 rests at 0.3 s, 2 runs on (sampling every 0.01 s) until the planner has seen it guessed
+// collapsed, then collapses. The planner asks for 5 while 2 is unknown (a wrong guess, taken by
+// the idle worker) and for 1.5 once 2 is guessed collapsed: 5 is cancelled, 1.5 runs ahead and
+// is taken by the next round.
+TEST(TrialPool, ATrialRunningPastTheStableOnesIsGuessedCollapsed) {
+  std::atomic<bool> guessed{false};
+  std::atomic<int> runs_of_5{0};
+  TrialPool pool(
+      2,
+      [&](double lambda, const TrialPool::Sample& sample) {
+        TrialResult r = fake(lambda, 1.75);
+        if (lambda == 1.0) r.sim_time = 0.3;
+        if (lambda == 2.0)
+          for (double t = 0.0; !guessed.load() && t < 1e4; t += 0.01) sample(t);
+        if (lambda == 5.0) {
+          ++runs_of_5;
+          for (double t = 0.0; sample(t) && t < 1e4; t += 1e-6) std::this_thread::yield();
+        }
+        return r;
+      },
+      [](const TrialResult&) {});
+  const std::vector<TrialResult> out = pool.run_round(
+      {1.0, 2.0}, [&](const std::vector<Outcome3>& known, const std::map<double, bool>& done) {
+        EXPECT_TRUE(done.count(2.0) == 0 || known[1] != Outcome3::Unknown);
+        if (known[0] == Outcome3::NotCrossed && known[1] == Outcome3::Crossed) {
+          guessed = true;
+          return std::vector<double>{1.5};
+        }
+        return std::vector<double>{5.0};
+      });
+  EXPECT_TRUE(guessed.load());
+  EXPECT_TRUE(out[1].collapsed);
+  const std::vector<TrialResult> next = pool.run_round({1.5}, TrialPool::nothing_ahead);
+  EXPECT_FALSE(next.front().collapsed);
+  pool.cancel_ahead();
+  const PoolStats st = pool.stats();
+  EXPECT_EQ(st.ahead_used, 1);
+  EXPECT_EQ(st.cancelled, runs_of_5.load());
 }
 
 Config block_deck() {
