@@ -4,7 +4,7 @@
 // The k-section of `capacity` runs its rounds one after the other, the `points` trials of a
 // round side by side. A round lasts as long as its longest trial, and near lambda* that is a
 // collapsing trial that starts slowly (critical slowing down: church B's last round holds a
-// stable trial of 25 s of wall and a collapse of 50 s), so a core waits idle for half the
+// stable trial of 9 s of wall and a collapse of 14 s), so a core waits idle for part of the
 // round. The pool gives such a core the trial the search is most likely to ask for next: the
 // search hands each round a planner (drivers/bracket.hpp probes_ahead: the next rounds' probes
 // with the round's pending outcomes guessed, and every trial that has ended, run ahead or not,
@@ -21,7 +21,9 @@
 // trial reports the simulated time it has reached at its samples, and the plan is made again
 // when one runs past that horizon, so a core that took a wrong guess is freed at once. (The
 // planner's rule alone, an estimate of lambda* from limit analysis, guessed church B's first
-// collapse stable and ran the wrong round ahead.)
+// collapse stable and ran the wrong round ahead. A horizon of 1.5 or 2 times the stable
+// trials' longest time guesses a collapse later, and the idle core gains less of its round:
+// scripts/ahead_guess --timeline, docs/capacity.md.)
 //
 // What the search sees does not change: each trial's result is a function of its lambda alone
 // (every trial starts from a copy of the same settled state), and the search reads only the
