@@ -590,8 +590,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
 
   if (hi > lo) {
     // The deck's bracket: both ends are run, side by side (a lower end of 0 is not). A lower
-    // end that collapses widens the bracket down; an upper end that stands starts the growth
-    // below from it.
+    // end that collapses widens the bracket down, an upper end that stands widens it up.
     std::vector<double> ends;
     if (lo > 0.0) ends.push_back(lo);
     ends.push_back(hi);
@@ -601,7 +600,7 @@ CapacityResult find_capacity(const Config& config, const TrialCriteria& crit,
       widen_down(lo);
       have_hi = true;
     } else if (!have_hi) {
-      lo = hi;
+      widen_up(hi);
     }
   } else if (search.seed_from_limit) {
     // Towards -x: limit analysis of the mirror image towards +x.

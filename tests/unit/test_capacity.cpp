@@ -197,8 +197,8 @@ normal_stiffness = 1e6
 }
 
 // The deck's bracket (capacity.lambda_min, lambda_max) is run at both ends, side by side: a
-// bracket that holds is searched in, and one whose lower end collapses widens down from it, as
-// a contradicted seed does.
+// bracket that holds is searched in, one whose lower end collapses widens down from it and one
+// whose upper end stands widens up, as a contradicted seed does.
 TEST(Capacity, TheDecksBracketIsRunAtBothEnds) {
   Config held = block_deck(0.8);
   held.capacity.lambda_min = 0.45;
@@ -231,6 +231,17 @@ TEST(Capacity, TheDecksBracketIsRunAtBothEnds) {
       EXPECT_TRUE(t.collapsed) << t.lambda;
     }
   }
+
+  Config below = block_deck(0.8);
+  below.capacity.lambda_min = 0.3;
+  below.capacity.lambda_max = 0.4;
+  const CapacityResult u = find_capacity(below, TrialCriteria{}, 2, true);
+  ASSERT_TRUE(u.bracketed);
+  EXPECT_EQ(u.trials[1].lambda, 0.4);
+  EXPECT_FALSE(u.trials[1].collapsed);
+  EXPECT_GT(u.seed.widenings, 0);
+  EXPECT_GE(u.lo, 0.4);
+  EXPECT_NEAR(u.lambda_star, 0.5, 0.005);
 }
 
 // The settle under gravity does not read the load direction, so `--direction both` settles
