@@ -29,6 +29,18 @@ friction = )" + std::to_string(mu) + "\n";
   return parse_deck(text, "block.toml");
 }
 
+// Every trial lies on its side of the final bracket.
+void expect_trials_on_their_sides(const CapacityResult& r) {
+  for (const TrialResult& t : r.trials) {
+    if (t.lambda <= r.lo) {
+      EXPECT_FALSE(t.collapsed) << t.lambda;
+    }
+    if (t.lambda >= r.hi) {
+      EXPECT_TRUE(t.collapsed) << t.lambda;
+    }
+  }
+}
+
 TEST(Capacity, BlockOverturnsAtWidthOverHeight) {
   const CapacityResult r = find_capacity(block_deck(0.8), TrialCriteria{}, 2, true);
   ASSERT_TRUE(r.bracketed);
@@ -45,15 +57,7 @@ TEST(Capacity, BlockSlidesAtFriction) {
   EXPECT_NEAR(r.lambda_star, 0.3, 0.003);
   ASSERT_FALSE(r.hinges.empty());
   EXPECT_EQ(r.hinges.front().kind, "sliding");
-  // Every trial lies on its side of the final bracket.
-  for (const TrialResult& t : r.trials) {
-    if (t.lambda <= r.lo) {
-      EXPECT_FALSE(t.collapsed) << t.lambda;
-    }
-    if (t.lambda >= r.hi) {
-      EXPECT_TRUE(t.collapsed) << t.lambda;
-    }
-  }
+  expect_trials_on_their_sides(r);
 }
 
 // A block on a ground inclined at 20 degrees with mu = 0.2 < tan 20 = 0.36 slides off under
@@ -196,14 +200,19 @@ normal_stiffness = 1e6
   EXPECT_TRUE(hi_ran);
 }
 
+// The block's search (mu 0.8: lambda* 0.5) from the deck's bracket [lo, hi].
+CapacityResult from_deck_bracket(double lo, double hi) {
+  Config deck = block_deck(0.8);
+  deck.capacity.lambda_min = lo;
+  deck.capacity.lambda_max = hi;
+  return find_capacity(deck, TrialCriteria{}, 2, true);
+}
+
 // The deck's bracket (capacity.lambda_min, lambda_max) is run at both ends, side by side: a
 // bracket that holds is searched in, one whose lower end collapses widens down from it and one
 // whose upper end stands widens up, as a contradicted seed does.
 TEST(Capacity, TheDecksBracketIsRunAtBothEnds) {
-  Config held = block_deck(0.8);
-  held.capacity.lambda_min = 0.45;
-  held.capacity.lambda_max = 0.55;
-  const CapacityResult r = find_capacity(held, TrialCriteria{}, 2, true);
+  const CapacityResult r = from_deck_bracket(0.45, 0.55);
   ASSERT_TRUE(r.bracketed);
   ASSERT_GE(r.trials.size(), 2u);
   EXPECT_EQ(r.trials[0].lambda, 0.45);
@@ -213,35 +222,23 @@ TEST(Capacity, TheDecksBracketIsRunAtBothEnds) {
   EXPECT_EQ(r.seed.widenings, 0);
   EXPECT_NEAR(r.lambda_star, 0.5, 0.005);
 
-  Config above = block_deck(0.8);
-  above.capacity.lambda_min = 0.6;
-  above.capacity.lambda_max = 0.7;
-  const CapacityResult w = find_capacity(above, TrialCriteria{}, 2, true);
+  const CapacityResult w = from_deck_bracket(0.6, 0.7);
   ASSERT_TRUE(w.bracketed);
   EXPECT_EQ(w.trials[0].lambda, 0.6);
   EXPECT_TRUE(w.trials[0].collapsed);
   EXPECT_GT(w.seed.widenings, 0);
   EXPECT_LT(w.hi, 0.6);
   EXPECT_NEAR(w.lambda_star, 0.5, 0.005);
-  for (const TrialResult& t : w.trials) {
-    if (t.lambda <= w.lo) {
-      EXPECT_FALSE(t.collapsed) << t.lambda;
-    }
-    if (t.lambda >= w.hi) {
-      EXPECT_TRUE(t.collapsed) << t.lambda;
-    }
-  }
+  expect_trials_on_their_sides(w);
 
-  Config below = block_deck(0.8);
-  below.capacity.lambda_min = 0.3;
-  below.capacity.lambda_max = 0.4;
-  const CapacityResult u = find_capacity(below, TrialCriteria{}, 2, true);
+  const CapacityResult u = from_deck_bracket(0.3, 0.4);
   ASSERT_TRUE(u.bracketed);
   EXPECT_EQ(u.trials[1].lambda, 0.4);
   EXPECT_FALSE(u.trials[1].collapsed);
   EXPECT_GT(u.seed.widenings, 0);
   EXPECT_GE(u.lo, 0.4);
   EXPECT_NEAR(u.lambda_star, 0.5, 0.005);
+  expect_trials_on_their_sides(u);
 }
 
 // The settle under gravity does not read the load direction, so `--direction both` settles
