@@ -28,40 +28,32 @@ std::vector<double> probes_ahead(const Bracket& b, const std::vector<double>& pr
                                  const std::vector<Outcome3>& known, double tolerance, int points,
                                  ProbePlacement placement, int depth, double estimate,
                                  const std::map<double, bool>& finished) {
+  // What is known (lambda -> crossed): the trials that have ended and this round's outcomes.
+  std::map<double, bool> facts = finished;
+  for (std::size_t i = 0; i < probes.size(); ++i)
+    if (known[i] != Outcome3::Unknown) facts[probes[i]] = known[i] == Outcome3::Crossed;
   std::vector<double> ahead;
   Bracket cur = b;
   std::vector<double> round = probes;
-  std::vector<Outcome3> outcomes = known;
-  auto result = [&](double p) {
-    const auto it = finished.find(p);
-    return it == finished.end() ? Outcome3::Unknown
-                                : (it->second ? Outcome3::Crossed : Outcome3::NotCrossed);
-  };
   for (int d = 0; d < depth; ++d) {
     const double middle = std::isnan(estimate) ? 0.5 * (cur.lo + cur.hi) : estimate;
-    for (std::size_t i = 0; i < round.size(); ++i)
-      if (outcomes[i] == Outcome3::Unknown) outcomes[i] = result(round[i]);
     std::vector<bool> crossed(round.size());
     for (std::size_t i = 0; i < round.size(); ++i) {
-      if (outcomes[i] != Outcome3::Unknown) {
-        crossed[i] = outcomes[i] == Outcome3::Crossed;
+      const double p = round[i];
+      if (const auto it = facts.find(p); it != facts.end()) {
+        crossed[i] = it->second;
         continue;
       }
       bool below_crossed = false, above_uncrossed = false;
-      for (std::size_t j = 0; j < round.size(); ++j) {
-        below_crossed |= outcomes[j] == Outcome3::Crossed && round[j] < round[i];
-        above_uncrossed |= outcomes[j] == Outcome3::NotCrossed && round[j] > round[i];
+      for (const auto& [l, c] : facts) {
+        below_crossed |= c && l < p;
+        above_uncrossed |= !c && l > p;
       }
-      for (const auto& [l, c] : finished) {
-        below_crossed |= c && l < round[i];
-        above_uncrossed |= !c && l > round[i];
-      }
-      crossed[i] = below_crossed || (!above_uncrossed && round[i] > middle);
+      crossed[i] = below_crossed || (!above_uncrossed && p > middle);
     }
     if (!round.empty() && !narrow_bracket(cur, round, crossed)) break;
     if (!(cur.hi - cur.lo > tolerance * cur.hi)) break;  // shrink_bracket stops here
     round = bracket_probes(cur, points, placement);
-    outcomes.assign(round.size(), Outcome3::Unknown);
     ahead.insert(ahead.end(), round.rbegin(), round.rend());
   }
   return ahead;

@@ -77,7 +77,7 @@ void TrialPool::replan() {
   auto ended = [](const Entry& e) { return e.state == State::Done && !e.live->cancel.load(); };
   // Every trial that has ended, and the horizon of the stable ones (trial_pool.hpp).
   std::map<double, bool> finished;
-  double horizon = -std::numeric_limits<double>::infinity(), highest_stable = horizon;
+  double horizon = 0.0, highest_stable = -std::numeric_limits<double>::infinity();
   for (const auto& [l, e] : entries_) {
     if (!ended(e)) continue;
     finished[l] = e.result.collapsed;
