@@ -13,6 +13,7 @@
 #include "contact/contact.hpp"
 #include "contact/friction.hpp"
 #include "contact/joint_stiffness.hpp"
+#include "contact/quad_overlap.hpp"
 #include "contact/state_bytes.hpp"
 
 namespace voussoir {
@@ -498,6 +499,34 @@ void RigidContact::detect_at(const Model& model, const std::vector<double>& ux,
   inner_.resize(live_i_.size());
   for (std::size_t l = 0; l < live_i_.size(); ++l)
     inner_[l] = inner_lines(model, ux, uy, live_i_[l], live_j_[l]);
+  // Slots: the pairs of quadrilaterals in batches, the others after them.
+  quad_live_.clear(), other_live_.clear();
+  auto vertices = [this](Index k) { return piece_first_[k + 1] - piece_first_[k]; };
+  for (std::size_t l = 0; l < live_i_.size(); ++l)
+    (vertices(live_i_[l]) == 4 && vertices(live_j_[l]) == 4 ? quad_live_ : other_live_)
+        .push_back(Index(l));
+  const std::size_t batches = (quad_live_.size() + kQuadLanes - 1) / kQuadLanes;
+  const std::size_t quad_slots = batches * kQuadLanes;
+  slot_of_live_.assign(live_i_.size(), 0);
+  quad_ref_.assign(batches, QuadPairs{});
+  quad_p_.assign(quad_slots, -1), quad_q_.assign(quad_slots, -1);
+  for (std::size_t slot = 0; slot < quad_live_.size(); ++slot) {
+    const std::size_t live = std::size_t(quad_live_[slot]);
+    slot_of_live_[live] = Index(slot);
+    const Index p0 = piece_first_[live_i_[live]], q0 = piece_first_[live_j_[live]];
+    quad_p_[slot] = p0, quad_q_[slot] = q0;
+    QuadPairs& batch = quad_ref_[slot / kQuadLanes];
+    const std::size_t l = slot % kQuadLanes;
+    const Vec2 o = ref_[p0];
+    for (int k = 0; k < 4; ++k) {
+      batch.px[k][l] = ref_[p0 + k].x - o.x, batch.py[k][l] = ref_[p0 + k].y - o.y;
+      batch.qx[k][l] = ref_[q0 + k].x - o.x, batch.qy[k][l] = ref_[q0 + k].y - o.y;
+    }
+    batch.ox[l] = o.x, batch.oy[l] = o.y;
+  }
+  for (std::size_t k = 0; k < other_live_.size(); ++k)
+    slot_of_live_[std::size_t(other_live_[k])] = Index(quad_slots + k);
+  overlap_.resize(quad_slots + other_live_.size());
   moves_.resize(nb);
   for (std::size_t b = 0; b < nb; ++b) moves_[b] = has_pose(model, b);
   // The pieces the steps displace: those of the live pairs on bodies with a pose, in order.
@@ -711,8 +740,9 @@ void RigidContact::displace_live_pieces(const Model& model) {
   double damp_mb = 0.0, damp_ma = 0.0;    // and their moments on b and on a
   const double c_damp = beta_[p] * kn_t;  // beta kn t_z [N s/m2]
   for (Index live = live_first_[p]; live < live_first_[p + 1]; ++live) {
-    if (!overlap_on_[live]) continue;
-    const ConvexOverlap& o = overlap_[live];
+    const std::size_t slot = std::size_t(slot_of_live_[live]);
+    if (!overlap_.on[slot]) continue;
+    const ConvexOverlap o = overlap_.at(slot);
     const Vec2 f = (kn_t * o.area) * o.normal;  // on b
     force = force + f;
     mb += (o.centroid.x - cb_x) * f.y - (o.centroid.y - cb_y) * f.x;
@@ -721,7 +751,7 @@ void RigidContact::displace_live_pieces(const Model& model) {
     unit = o.normal;
     ++regions;
     gx += o.area * o.centroid.x, gy += o.area * o.centroid.y;
-    energy2 += o.depth_sq;
+    if (energy) energy2 += o.depth_sq;
     if (damping_) {
       // The viscous Winkler joint along this overlap's chord (rigid_contact.hpp).
       const Vec2 xm = o.chord_mid, n = o.normal;
@@ -785,30 +815,84 @@ void RigidContact::displace_live_pieces(const Model& model) {
   return true;
 }
 
-// The overlap of every live pair of pieces at the current configuration (overlap_,
-// overlap_on_), and the separating lines of those apart.
+void RigidContact::OverlapTable::resize(std::size_t slots) {
+  for (std::vector<double>* v : {&area, &gx, &gy, &nx, &ny, &chord, &mx, &my, &depth_sq})
+    v->assign(slots, 0.0);
+  on.assign(slots, 0);
+}
+
+// The overlap of every live pair of pieces at the current configuration (overlap_): the pairs
+// of quadrilaterals a batch at a time (quad_overlap.hpp), the others one by one, with the
+// separating lines of those apart. `energy`: the joints' energy too, by the ordered clipping
+// (depth_sq).
 void RigidContact::overlap_pieces(bool energy) {
   const Index* first = piece_first_.data();
   const Vec2* ref = ref_.data();
   const Vec2* disp = disp_.data();
-  const std::size_t n = live_i_.size();
-  overlap_.resize(n), overlap_on_.resize(n);
-  for (std::size_t live = 0; live < n; ++live) {
+  auto pieces_of = [&](std::size_t live, const Vec2*& pv, const Vec2*& pu, int& np, const Vec2*& qv,
+                       const Vec2*& qu, int& nq) {
     const Index i = live_i_[live], j = live_j_[live];
-    const Vec2 *pv = &ref[first[i]], *pu = &disp[first[i]];
-    const Vec2 *qv = &ref[first[j]], *qu = &disp[first[j]];
-    const int np = first[i + 1] - first[i];
-    const int nq = first[j + 1] - first[j];
+    pv = &ref[first[i]], pu = &disp[first[i]], qv = &ref[first[j]], qu = &disp[first[j]];
+    np = first[i + 1] - first[i], nq = first[j + 1] - first[j];
+  };
+  const Vec2 *pv, *pu, *qv, *qu;
+  int np, nq;
+  QuadPairs batch;
+  QuadOverlaps result;
+  OverlapTable& t = overlap_;
+  for (std::size_t b = 0; b < quad_ref_.size(); ++b) {
+    const QuadPairs& at_ref = quad_ref_[b];
+    for (int l = 0; l < kQuadLanes; ++l) {
+      const std::size_t lane = b * kQuadLanes + std::size_t(l);
+      // Reference and displacement parts apart, as the ordered clipping takes them; an unused
+      // lane keeps its zeros (no displacement).
+      static const Vec2 none[4] = {};
+      const bool used = quad_p_[lane] >= 0;
+      const Vec2* up = used ? disp + quad_p_[lane] : none;
+      const Vec2* uq = used ? disp + quad_q_[lane] : none;
+      const double oux = up[0].x, ouy = up[0].y;
+      for (int k = 0; k < 4; ++k) {
+        batch.px[k][l] = at_ref.px[k][l] + (up[k].x - oux);
+        batch.py[k][l] = at_ref.py[k][l] + (up[k].y - ouy);
+        batch.qx[k][l] = at_ref.qx[k][l] + (uq[k].x - oux);
+        batch.qy[k][l] = at_ref.qy[k][l] + (uq[k].y - ouy);
+      }
+      batch.ox[l] = at_ref.ox[l] + oux, batch.oy[l] = at_ref.oy[l] + ouy;
+    }
+    quad_overlaps(batch, result);
+    const std::size_t at = b * kQuadLanes;
+    std::copy_n(result.area, kQuadLanes, &t.area[at]);
+    std::copy_n(result.gx, kQuadLanes, &t.gx[at]), std::copy_n(result.gy, kQuadLanes, &t.gy[at]);
+    std::copy_n(result.nx, kQuadLanes, &t.nx[at]), std::copy_n(result.ny, kQuadLanes, &t.ny[at]);
+    std::copy_n(result.chord, kQuadLanes, &t.chord[at]);
+    std::copy_n(result.mx, kQuadLanes, &t.mx[at]), std::copy_n(result.my, kQuadLanes, &t.my[at]);
+    std::copy_n(result.on, kQuadLanes, &t.on[at]);
+  }
+  // The joints' energy (read only where `energy`: evaluate's out.energy).
+  for (std::size_t slot = 0; energy && slot < quad_live_.size(); ++slot) {
+    t.depth_sq[slot] = 0.0;
+    ConvexOverlap ordered;
+    const std::size_t live = std::size_t(quad_live_[slot]);
+    if (!t.on[slot]) continue;
+    pieces_of(live, pv, pu, np, qv, qu, nq);
+    if (overlap_of(pv, pu, np, qv, qu, nq, ordered, true, inner_[live]))
+      t.depth_sq[slot] = ordered.depth_sq;
+  }
+  for (const Index index : other_live_) {
+    const std::size_t live = std::size_t(index), slot = std::size_t(slot_of_live_[live]);
+    pieces_of(live, pv, pu, np, qv, qu, nq);
     std::int16_t& apart = apart_line_[live];
-    overlap_on_[live] = 0;
+    t.on[slot] = 0;
     if (apart >= 0 && separated_by(pv, pu, np, qv, qu, nq, apart)) continue;
-    // (Rejected: the vertex counts of two quadrilaterals, every piece pair of the churches, as
-    // constants for the compiler to unroll: no faster.)
-    if (!overlap_of(pv, pu, np, qv, qu, nq, overlap_[live], energy, inner_[live])) {
+    ConvexOverlap o;
+    if (!overlap_of(pv, pu, np, qv, qu, nq, o, energy, inner_[live])) {
       apart = std::int16_t(separating_line(pv, pu, np, qv, qu, nq));
       continue;
     }
-    overlap_on_[live] = 1;
+    t.on[slot] = 1;
+    t.area[slot] = o.area, t.gx[slot] = o.centroid.x, t.gy[slot] = o.centroid.y;
+    t.nx[slot] = o.normal.x, t.ny[slot] = o.normal.y, t.chord[slot] = o.chord;
+    t.mx[slot] = o.chord_mid.x, t.my[slot] = o.chord_mid.y, t.depth_sq[slot] = o.depth_sq;
   }
 }
 

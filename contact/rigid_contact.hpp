@@ -34,11 +34,15 @@
 //     |O| = 1/2 sum v_k x v_k+1,   G |O| = 1/6 sum (v_k + v_k+1) (v_k x v_k+1).
 // integral d^2 ds: between consecutive abscissae s_j of O's vertices along the chord, d is
 // linear, so that interval gives (s_j+1 - s_j)(d_j^2 + d_j d_j+1 + d_j+1^2) / 3, d_j the width
-// of O at s_j (its two edges there). O itself comes from clipping A's piece by each side line
-// of B's piece (Sutherland and Hodgman, CACM 17 (1974)), each vertex carrying which of the two
-// boundaries its outgoing edge lies on, so N_A needs no tolerance even for slivers of 1e-10 m.
-// A line of B that has every vertex on its inner side is skipped (a joint's overlap is cut by
-// one or two of B's sides).
+// of O at s_j (its two edges there). For two quadrilaterals (nearly every pair of pieces in
+// masonry) |O|, G and N_A come from the pieces of the two outlines' edges that lie inside the
+// other, a batch of pairs at a time (contact/quad_overlap.hpp). Otherwise, and for the energy
+// integral, which needs O's vertices in order, O comes from clipping A's piece by each side
+// line of B's piece (Sutherland and Hodgman, CACM 17 (1974)), each vertex carrying which of the
+// two boundaries its outgoing edge lies on, so N_A needs no tolerance even for slivers of
+// 1e-10 m. A line of B that has every vertex on its inner side is skipped (a joint's overlap is
+// cut by one or two of B's sides). The two ways agree to round-off of the coordinates
+// (RigidContact.QuadBatchAgreesWithTheOrderedClipping).
 //
 // Non-convex outlines (the church's crown blocks) are cut once, in the reference
 // configuration, into convex pieces: the block's own triangles merged greedily across shared
@@ -102,6 +106,7 @@
 #include <vector>
 
 #include "contact/broad_phase.hpp"
+#include "contact/quad_overlap.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
 
@@ -251,11 +256,20 @@ class RigidContact {
   std::vector<double> slip_x_, slip_y_;   // friction state [m]
   std::vector<std::uint8_t> touched_;     // 1 when the pair touched at the last step
   std::vector<double> last_w_;            // 4 per pair: F_x, F_y, M_b, M_a of the last step
-  // Scratch of add_forces: each pair's joint energy and friction spring energy of the step [J],
-  // and the overlap of each live pair of pieces (overlap_on_ 1 when they overlap).
+  // Scratch of add_forces: each pair's joint energy and friction spring energy of the step [J].
   std::vector<double> pair_energy_, pair_stored_;
-  std::vector<ConvexOverlap> overlap_;
-  std::vector<std::uint8_t> overlap_on_;
+  // The overlap of each live pair of pieces (below) at the current configuration, by slot: the
+  // pairs of quadrilaterals first, a batch of kQuadLanes after another, then the others.
+  struct OverlapTable {
+    std::vector<double> area, gx, gy, nx, ny, chord, mx, my, depth_sq;
+    std::vector<long> on;  // nonzero when the pieces overlap
+    void resize(std::size_t slots);
+    ConvexOverlap at(std::size_t slot) const {
+      return {area[slot],  {gx[slot], gy[slot]}, {nx[slot], ny[slot]},
+              chord[slot], {mx[slot], my[slot]}, depth_sq[slot]};
+    }
+  };
+  OverlapTable overlap_;
   // The pairs of convex pieces of each candidate pair that were within the buffer at the
   // detection (pair p's: [live_first_[p], live_first_[p + 1]) of live_i_, live_j_), and for
   // each a side line that separated them at the last evaluation, or -1 (separated_by's
@@ -267,6 +281,14 @@ class RigidContact {
   // on their inner side until the next detection (convex_overlap's `inner`; "Lines that cannot
   // cut" above).
   std::vector<std::uint32_t> inner_;
+  // The live pairs of pieces that are both quadrilaterals (evaluated in batches) and the
+  // others; the slot of each live pair in overlap_.
+  std::vector<Index> quad_live_, other_live_, slot_of_live_;
+  // Per batch of quadrilateral pairs: the vertices' reference positions relative to P's first
+  // (QuadPairs without the displacements; ox, oy: P's first vertex), and per lane the first
+  // vertex of P and of Q in ref_ and disp_ (-1: an unused lane).
+  std::vector<QuadPairs> quad_ref_;
+  std::vector<Index> quad_p_, quad_q_;
 
   // Ledger: per body (3 values: x, y, rotation) the dashpot and friction forces of this and of
   // the last step.

@@ -9,9 +9,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "contact/quad_overlap.hpp"
 #include "contact/rigid_contact.hpp"
 #include "core/rigid.hpp"
 #include "core/step.hpp"
@@ -30,9 +32,51 @@ std::vector<Vec2> box(double x0, double y0, double x1, double y1) {
   return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
 }
 
+// The overlap of two quadrilaterals by the batch kernel (contact/quad_overlap.hpp), in lane
+// `lane` of a batch whose other lanes hold other pairs; false when it finds none.
+bool quad_overlap(const std::vector<Vec2>& p, const std::vector<Vec2>& q, ConvexOverlap& o,
+                  int lane = 0) {
+  QuadPairs batch;
+  for (int l = 0; l < kQuadLanes; ++l)
+    for (int k = 0; k < 4; ++k) {
+      // Other lanes: the pair turned by l quarter turns about P's first vertex.
+      const Vec2 a = p[std::size_t(k)] - p[0], b = q[std::size_t(k)] - p[0];
+      const int turns = l == lane ? 0 : l + 1;
+      const double c = std::cos(turns * 1.5707963267948966),
+                   s = std::sin(turns * 1.5707963267948966);
+      batch.px[k][l] = c * a.x - s * a.y, batch.py[k][l] = s * a.x + c * a.y;
+      batch.qx[k][l] = c * b.x - s * b.y, batch.qy[k][l] = s * b.x + c * b.y;
+      batch.ox[l] = p[0].x, batch.oy[l] = p[0].y;
+    }
+  QuadOverlaps out;
+  quad_overlaps(batch, out);
+  if (!out.on[lane]) return false;
+  o.area = out.area[lane];
+  o.centroid = {out.gx[lane], out.gy[lane]};
+  o.normal = {out.nx[lane], out.ny[lane]};
+  o.chord = out.chord[lane];
+  o.chord_mid = {out.mx[lane], out.my[lane]};
+  return true;
+}
+
+// The overlap by the ordered clipping; for two quadrilaterals, the batch kernel's force terms
+// checked against it.
 ConvexOverlap overlap(const std::vector<Vec2>& p, const std::vector<Vec2>& q) {
   ConvexOverlap o;
   EXPECT_TRUE(convex_overlap(p.data(), int(p.size()), q.data(), int(q.size()), o));
+  if (p.size() == 4 && q.size() == 4) {
+    ConvexOverlap b;
+    EXPECT_TRUE(quad_overlap(p, q, b, 3));
+    const double scale = std::sqrt(o.area) + o.chord;
+    EXPECT_NEAR(b.area, o.area, 1e-14 * scale * scale);
+    EXPECT_NEAR(b.centroid.x, o.centroid.x, 1e-12 * scale);
+    EXPECT_NEAR(b.centroid.y, o.centroid.y, 1e-12 * scale);
+    EXPECT_NEAR(b.normal.x, o.normal.x, 1e-12);
+    EXPECT_NEAR(b.normal.y, o.normal.y, 1e-12);
+    EXPECT_NEAR(b.chord, o.chord, 1e-12 * scale);
+    EXPECT_NEAR(b.chord_mid.x, o.chord_mid.x, 1e-12 * scale);
+    EXPECT_NEAR(b.chord_mid.y, o.chord_mid.y, 1e-12 * scale);
+  }
   return o;
 }
 
@@ -127,6 +171,97 @@ TEST(RigidContact, ApartPolygonsHaveASeparatingLine) {
   EXPECT_TRUE(separated_by(p.data(), 4, q.data(), 4, line));
   const std::vector<Vec2> touching = box(0.9, 0.2, 2.0, 0.8);
   EXPECT_EQ(separating_line(p.data(), 4, touching.data(), 4), -1);
+}
+
+// The batch kernel against the ordered clipping on random pairs of quadrilaterals of the kinds
+// a masonry structure has: joints (Q built on a side of P, its two corners on P's, then moved
+// by a penetration of 1e-10 to 1e-3 of the side, turned by as little and slid), corners pushed
+// into faces, and pairs overlapping anyhow. Both find an overlap or neither; the force terms
+// agree to round-off of the pair's size.
+TEST(RigidContact, QuadBatchAgreesWithTheOrderedClipping) {
+  std::mt19937_64 rng(20261127);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto quad = [&](double size) {
+    // A convex quadrilateral: four points on an ellipse at jittered angles.
+    const double a = size * (0.5 + unit(rng)), b = size * (0.5 + unit(rng)), turn = 6.3 * unit(rng);
+    std::vector<Vec2> v;
+    for (int k = 0; k < 4; ++k) {
+      const double t = turn + 1.5707963267948966 * (k + 0.6 * (unit(rng) - 0.5));
+      v.push_back({a * std::cos(t), b * std::sin(t)});
+    }
+    return v;
+  };
+  int overlaps = 0, agreed = 0, joints = 0;
+  double tilt = 0.0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::vector<Vec2> p = quad(1.0), q;
+    const int kind = trial % 3;
+    if (kind == 0) {  // a joint on P's side k
+      const int k = int(4 * unit(rng)) % 4;
+      const Vec2 a = p[std::size_t(k)], b = p[std::size_t((k + 1) % 4)];
+      const Vec2 e = b - a;
+      const double len = std::hypot(e.x, e.y);
+      const Vec2 n{e.y / len, -e.x / len};  // out of P
+      const double h = 0.3 + unit(rng);
+      q = {b, a, a + h * n + (0.3 * (unit(rng) - 0.5)) * e,
+           b + h * n + (0.3 * (unit(rng) - 0.5)) * e};
+      const double depth = len * std::pow(10.0, -10.0 + 7.0 * unit(rng));
+      tilt = (unit(rng) - 0.5) * std::pow(10.0, -10.0 + 7.0 * unit(rng));
+      const Vec2 slide = (len * (unit(rng) - 0.5) * std::pow(10.0, -6.0 * unit(rng))) * e;
+      const Vec2 mid = 0.5 * (a + b);
+      for (Vec2& v : q) {
+        const Vec2 r = v - mid;
+        v = mid + Vec2{r.x - tilt * r.y, r.y + tilt * r.x} - depth * n + (1.0 / len) * slide;
+      }
+      ++joints;
+    } else {
+      q = quad(kind == 1 ? 0.5 : 1.5);
+      const Vec2 shift{2.0 * (unit(rng) - 0.5), 2.0 * (unit(rng) - 0.5)};
+      for (Vec2& v : q) v = v + shift;
+    }
+    ConvexOverlap o, b;
+    // Round-off of the coordinates (1e-16 of the size, 1 here) moves the area by as much times
+    // the size, the centroid of a sliver by the area's relative error times the size, and a
+    // point where two outlines cross at an angle alpha by as much over alpha (the faces of a
+    // joint turned by `tilt` cross at that angle).
+    const double crossing = kind == 0 ? 1e-15 / std::abs(tilt) : 0.0;
+    const bool ordered = convex_overlap(p.data(), 4, q.data(), 4, o, false);
+    const bool batch = quad_overlap(p, q, b, trial % kQuadLanes);
+    const double scale = ordered ? std::sqrt(o.area) + o.chord : 1.0;
+    // One piece wholly inside the other has no chord: the ordered clipping's sum of the edges
+    // then leaves round-off, 1e-16, where the batch finds no crossing and no overlap.
+    if (ordered && o.chord < 1e-12) {
+      EXPECT_FALSE(batch) << "trial " << trial;
+      continue;
+    }
+    // A touch of no area may be found by one and not the other.
+    if (ordered != batch) {
+      EXPECT_LT(ordered ? o.area : b.area, 1e-14) << "trial " << trial;
+      continue;
+    }
+    if (!ordered) continue;
+    ++overlaps;
+    const double sliver = 1e-15 / o.area;
+    const bool same = std::abs(b.area - o.area) <= 1e-13 * o.area + 1e-15 &&
+                      std::abs(b.centroid.x - o.centroid.x) <= 1e-12 * scale + sliver &&
+                      std::abs(b.centroid.y - o.centroid.y) <= 1e-12 * scale + sliver &&
+                      std::abs(b.normal.x - o.normal.x) <= 1e-9 &&
+                      std::abs(b.normal.y - o.normal.y) <= 1e-9 &&
+                      std::abs(b.chord - o.chord) <= 1e-12 * scale + crossing &&
+                      std::abs(b.chord_mid.x - o.chord_mid.x) <= 1e-12 * scale + crossing &&
+                      std::abs(b.chord_mid.y - o.chord_mid.y) <= 1e-12 * scale + crossing;
+    EXPECT_TRUE(same) << "trial " << trial << ": area " << b.area << " against " << o.area
+                      << ", normal (" << b.normal.x << ", " << b.normal.y << ") against ("
+                      << o.normal.x << ", " << o.normal.y << "), chord " << b.chord << " against "
+                      << o.chord << ", centroid (" << b.centroid.x - o.centroid.x << ", "
+                      << b.centroid.y - o.centroid.y << "), middle ("
+                      << b.chord_mid.x - o.chord_mid.x << ", " << b.chord_mid.y - o.chord_mid.y
+                      << ")";
+    agreed += same;
+  }
+  EXPECT_GT(overlaps, 1500);
+  EXPECT_EQ(agreed, overlaps);
+  EXPECT_EQ(joints, 1000);
 }
 
 // Skipping a side line of Q that leaves P whole (convex_overlap's `inner`, certified by the
