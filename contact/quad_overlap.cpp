@@ -127,8 +127,8 @@ void quad_overlaps(const QuadPairs& in, QuadOverlaps& out) {
   const Mask on = (a2 > zero) & (chord_sq > zero) & (count > zero);
   alignas(64) double root[kQuadLanes];
   store(root, chord_sq);
-  // A square root per lane, in the vector unit: the file is built without errno for the
-  // math functions (CMakeLists.txt), which a sum of squares never needs.
+  // A square root per lane, inline: the file is built without errno for the math functions
+  // (CMakeLists.txt), which a sum of squares never needs, so no lane calls the library.
   for (int l = 0; l < kQuadLanes; ++l) root[l] = __builtin_sqrt(root[l]);
   const Lanes chord = load(root);
   const Lanes safe_a2 = select(on, a2, one), safe_chord = select(on, chord, one);

@@ -46,8 +46,8 @@ struct QuadPairs {
 };
 
 // The overlap of each lane's pair, positions absolute (the origin added); `on` nonzero when P
-// and Q overlap with an area and a chord (ConvexOverlap's conditions), else the other values
-// mean nothing.
+// and Q overlap with an area and their outlines cross (ConvexOverlap's conditions), else the
+// other values mean nothing.
 struct QuadOverlaps {
   alignas(64) double area[kQuadLanes];                // |O| [m2]
   alignas(64) double gx[kQuadLanes], gy[kQuadLanes];  // G [m]
@@ -57,7 +57,7 @@ struct QuadOverlaps {
   alignas(64) long on[kQuadLanes];
 };
 
-// The batch's overlaps into `out` at lane offset 0 of each of its arrays.
+// The overlaps of the batch's pairs, lane by lane.
 void quad_overlaps(const QuadPairs& in, QuadOverlaps& out);
 
 }  // namespace voussoir
