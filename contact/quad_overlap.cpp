@@ -42,7 +42,7 @@ struct Piece {
                                               bool strict) {
   const Lanes zero = splat(0.0), one = splat(1.0);
   Lanes t0 = zero, t1 = one;
-  Mask empty = Mask{} != Mask{};  // all false
+  Mask empty{};  // all lanes false
   for (int j = 0; j < 4; ++j) {
     const Mask in_a = strict ? da[j] > zero : da[j] >= zero;
     const Mask in_b = strict ? db[j] > zero : db[j] >= zero;

@@ -821,6 +821,12 @@ void RigidContact::OverlapTable::resize(std::size_t slots) {
   on.assign(slots, 0);
 }
 
+void RigidContact::OverlapTable::set(std::size_t slot, const ConvexOverlap& o) {
+  area[slot] = o.area, gx[slot] = o.centroid.x, gy[slot] = o.centroid.y;
+  nx[slot] = o.normal.x, ny[slot] = o.normal.y, chord[slot] = o.chord;
+  mx[slot] = o.chord_mid.x, my[slot] = o.chord_mid.y, depth_sq[slot] = o.depth_sq;
+}
+
 // The overlap of every live pair of pieces at the current configuration (overlap_): the pairs
 // of quadrilaterals a batch at a time (quad_overlap.hpp), the others one by one, with the
 // separating lines of those apart. `energy`: the joints' energy too, by the ordered clipping
@@ -890,9 +896,7 @@ void RigidContact::overlap_pieces(bool energy) {
       continue;
     }
     t.on[slot] = 1;
-    t.area[slot] = o.area, t.gx[slot] = o.centroid.x, t.gy[slot] = o.centroid.y;
-    t.nx[slot] = o.normal.x, t.ny[slot] = o.normal.y, t.chord[slot] = o.chord;
-    t.mx[slot] = o.chord_mid.x, t.my[slot] = o.chord_mid.y, t.depth_sq[slot] = o.depth_sq;
+    t.set(slot, o);
   }
 }
 

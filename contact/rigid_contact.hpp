@@ -264,6 +264,7 @@ class RigidContact {
     std::vector<double> area, gx, gy, nx, ny, chord, mx, my, depth_sq;
     std::vector<long> on;  // nonzero when the pieces overlap
     void resize(std::size_t slots);
+    void set(std::size_t slot, const ConvexOverlap& o);
     ConvexOverlap at(std::size_t slot) const {
       return {area[slot],  {gx[slot], gy[slot]}, {nx[slot], ny[slot]},
               chord[slot], {mx[slot], my[slot]}, depth_sq[slot]};

@@ -37,17 +37,18 @@ std::vector<Vec2> box(double x0, double y0, double x1, double y1) {
 bool quad_overlap(const std::vector<Vec2>& p, const std::vector<Vec2>& q, ConvexOverlap& o,
                   int lane = 0) {
   QuadPairs batch;
-  for (int l = 0; l < kQuadLanes; ++l)
+  for (int l = 0; l < kQuadLanes; ++l) {
+    // Other lanes: the pair turned by l + 1 quarter turns about P's first vertex.
+    const int turns = l == lane ? 0 : l + 1;
+    const double c = std::cos(turns * 1.5707963267948966),
+                 s = std::sin(turns * 1.5707963267948966);
     for (int k = 0; k < 4; ++k) {
-      // Other lanes: the pair turned by l quarter turns about P's first vertex.
       const Vec2 a = p[std::size_t(k)] - p[0], b = q[std::size_t(k)] - p[0];
-      const int turns = l == lane ? 0 : l + 1;
-      const double c = std::cos(turns * 1.5707963267948966),
-                   s = std::sin(turns * 1.5707963267948966);
       batch.px[k][l] = c * a.x - s * a.y, batch.py[k][l] = s * a.x + c * a.y;
       batch.qx[k][l] = c * b.x - s * b.y, batch.qy[k][l] = s * b.x + c * b.y;
-      batch.ox[l] = p[0].x, batch.oy[l] = p[0].y;
     }
+    batch.ox[l] = p[0].x, batch.oy[l] = p[0].y;
+  }
   QuadOverlaps out;
   quad_overlaps(batch, out);
   if (!out.on[lane]) return false;
