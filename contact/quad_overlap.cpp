@@ -65,6 +65,28 @@ struct Piece {
 
 }  // namespace
 
+void quad_place(const QuadPairs& ref, const QuadPairs& offset, const QuadPoses& pose,
+                QuadPairs& out) {
+  const Lanes p_ux = load(pose.p_ux), p_uy = load(pose.p_uy);
+  const Lanes p_cm1 = load(pose.p_cm1), p_s = load(pose.p_s);
+  const Lanes q_ux = load(pose.q_ux), q_uy = load(pose.q_uy);
+  const Lanes q_cm1 = load(pose.q_cm1), q_s = load(pose.q_s);
+  Lanes ux[4], uy[4], vx[4], vy[4];  // the displacements of P's and Q's vertices
+  for (int k = 0; k < 4; ++k) {
+    const Lanes rx = load(offset.px[k]), ry = load(offset.py[k]);
+    ux[k] = p_ux + p_cm1 * rx - p_s * ry, uy[k] = p_uy + p_s * rx + p_cm1 * ry;
+    const Lanes sx = load(offset.qx[k]), sy = load(offset.qy[k]);
+    vx[k] = q_ux + q_cm1 * sx - q_s * sy, vy[k] = q_uy + q_s * sx + q_cm1 * sy;
+  }
+  for (int k = 0; k < 4; ++k) {
+    store(out.px[k], load(ref.px[k]) + (ux[k] - ux[0]));
+    store(out.py[k], load(ref.py[k]) + (uy[k] - uy[0]));
+    store(out.qx[k], load(ref.qx[k]) + (vx[k] - ux[0]));
+    store(out.qy[k], load(ref.qy[k]) + (vy[k] - uy[0]));
+  }
+  store(out.ox, load(ref.ox) + ux[0]), store(out.oy, load(ref.oy) + uy[0]);
+}
+
 void quad_overlaps(const QuadPairs& in, QuadOverlaps& out) {
   Lanes px[4], py[4], qx[4], qy[4];
   for (int k = 0; k < 4; ++k) {

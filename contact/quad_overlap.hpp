@@ -57,6 +57,22 @@ struct QuadOverlaps {
   alignas(64) long on[kQuadLanes];
 };
 
+// The bodies of a batch's pairs at their current poses, per lane: P's body and Q's, each by its
+// centroid's displacement (ux, uy) and cos(theta) - 1, sin(theta) of its rotation (zeros for a
+// body without a pose of its own, and for unused lanes).
+struct QuadPoses {
+  alignas(64) double p_ux[kQuadLanes], p_uy[kQuadLanes], p_cm1[kQuadLanes], p_s[kQuadLanes];
+  alignas(64) double q_ux[kQuadLanes], q_uy[kQuadLanes], q_cm1[kQuadLanes], q_s[kQuadLanes];
+};
+
+// A batch at the bodies' poses: `ref` holds the vertices' reference positions relative to P's
+// first vertex (and that vertex in ox, oy), `offset` each vertex's offset r from its body's
+// reference centroid. Each vertex is displaced by u = (ux, uy) + (R - I) r, and the batch is
+// placed relative to P's first displaced vertex: the numbers of RigidContact's one-pair path,
+// which displaces every vertex and subtracts.
+void quad_place(const QuadPairs& ref, const QuadPairs& offset, const QuadPoses& pose,
+                QuadPairs& out);
+
 // The overlaps of the batch's pairs, lane by lane.
 void quad_overlaps(const QuadPairs& in, QuadOverlaps& out);
 

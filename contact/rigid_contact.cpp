@@ -509,12 +509,10 @@ void RigidContact::detect_at(const Model& model, const std::vector<double>& ux,
   const std::size_t quad_slots = batches * kQuadLanes;
   slot_of_live_.assign(live_i_.size(), 0);
   quad_ref_.assign(batches, QuadPairs{});
-  quad_p_.assign(quad_slots, -1), quad_q_.assign(quad_slots, -1);
   for (std::size_t slot = 0; slot < quad_live_.size(); ++slot) {
     const std::size_t live = std::size_t(quad_live_[slot]);
     slot_of_live_[live] = Index(slot);
     const Index p0 = piece_first_[live_i_[live]], q0 = piece_first_[live_j_[live]];
-    quad_p_[slot] = p0, quad_q_[slot] = q0;
     QuadPairs& batch = quad_ref_[slot / kQuadLanes];
     const std::size_t l = slot % kQuadLanes;
     const Vec2 o = ref_[p0];
@@ -542,6 +540,22 @@ void RigidContact::detect_at(const Model& model, const std::vector<double>& ux,
     const std::size_t b = std::size_t(piece_block_[k]);
     for (Index v = piece_first_[k]; v < piece_first_[k + 1]; ++v)
       offset_[v] = {ref_[v].x - r.cx0[b], ref_[v].y - r.cy0[b]};
+  }
+  // The batches' offsets and bodies (quad_place).
+  quad_offset_.assign(batches, QuadPairs{});
+  quad_body_p_.assign(quad_slots, Index(nb)), quad_body_q_.assign(quad_slots, Index(nb));
+  for (std::size_t slot = 0; slot < quad_live_.size(); ++slot) {
+    const std::size_t live = std::size_t(quad_live_[slot]), l = slot % kQuadLanes;
+    QuadPairs& batch = quad_offset_[slot / kQuadLanes];
+    auto place = [&](Index piece, Index& body, double(&x)[4][kQuadLanes],
+                     double(&y)[4][kQuadLanes]) {
+      if (!moves_[std::size_t(piece_block_[piece])]) return;
+      body = piece_block_[piece];
+      for (int k = 0; k < 4; ++k)
+        x[k][l] = offset_[piece_first_[piece] + k].x, y[k][l] = offset_[piece_first_[piece] + k].y;
+    };
+    place(live_i_[live], quad_body_p_[slot], batch.px, batch.py);
+    place(live_j_[live], quad_body_q_[slot], batch.qx, batch.qy);
   }
   // Carry the friction slip and whether the pair touched by the block pair.
   const std::size_t np = next.size();
@@ -724,6 +738,25 @@ void RigidContact::displace_live_pieces(const Model& model) {
   }
 }
 
+void RigidContact::pose_bodies(const Model& model) {
+  const std::size_t nb = moves_.size();
+  // One more entry, at nb, stays zero: the pose of a lane without a body.
+  if (pose_ux_.size() != nb + 1) {
+    pose_ux_.assign(nb + 1, 0.0), pose_uy_.assign(nb + 1, 0.0);
+    pose_cm1_.assign(nb + 1, 0.0), pose_s_.assign(nb + 1, 0.0);
+  }
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (!moves_[b]) {
+      pose_ux_[b] = pose_uy_[b] = pose_cm1_[b] = pose_s_[b] = 0.0;
+      continue;
+    }
+    double sh, ch;
+    half_angle(model.rigid.theta[b], sh, ch);
+    pose_cm1_[b] = -2.0 * sh * sh, pose_s_[b] = 2.0 * sh * ch;
+    pose_ux_[b] = model.rigid.ux[b], pose_uy_[b] = model.rigid.uy[b];
+  }
+}
+
 // Pair p at the current configuration: false when its blocks do not overlap (its history is
 // then dropped). Inlined into the contact stage's pair loop.
 [[gnu::always_inline]] inline bool RigidContact::evaluate(std::size_t p, const BodyView& r,
@@ -846,25 +879,17 @@ void RigidContact::overlap_pieces(bool energy) {
   QuadPairs batch;
   QuadOverlaps result;
   OverlapTable& t = overlap_;
+  QuadPoses pose;
   for (std::size_t b = 0; b < quad_ref_.size(); ++b) {
-    const QuadPairs& at_ref = quad_ref_[b];
     for (int l = 0; l < kQuadLanes; ++l) {
       const std::size_t lane = b * kQuadLanes + std::size_t(l);
-      // Reference and displacement parts apart, as the ordered clipping takes them; an unused
-      // lane keeps its zeros (no displacement).
-      static const Vec2 none[4] = {};
-      const bool used = quad_p_[lane] >= 0;
-      const Vec2* up = used ? disp + quad_p_[lane] : none;
-      const Vec2* uq = used ? disp + quad_q_[lane] : none;
-      const double oux = up[0].x, ouy = up[0].y;
-      for (int k = 0; k < 4; ++k) {
-        batch.px[k][l] = at_ref.px[k][l] + (up[k].x - oux);
-        batch.py[k][l] = at_ref.py[k][l] + (up[k].y - ouy);
-        batch.qx[k][l] = at_ref.qx[k][l] + (uq[k].x - oux);
-        batch.qy[k][l] = at_ref.qy[k][l] + (uq[k].y - ouy);
-      }
-      batch.ox[l] = at_ref.ox[l] + oux, batch.oy[l] = at_ref.oy[l] + ouy;
+      const std::size_t bp = quad_body_p_[lane], bq = quad_body_q_[lane];
+      pose.p_ux[l] = pose_ux_[bp], pose.p_uy[l] = pose_uy_[bp];
+      pose.p_cm1[l] = pose_cm1_[bp], pose.p_s[l] = pose_s_[bp];
+      pose.q_ux[l] = pose_ux_[bq], pose.q_uy[l] = pose_uy_[bq];
+      pose.q_cm1[l] = pose_cm1_[bq], pose.q_s[l] = pose_s_[bq];
     }
+    quad_place(quad_ref_[b], quad_offset_[b], pose, batch);
     quad_overlaps(batch, result);
     const std::size_t at = b * kQuadLanes;
     std::copy_n(result.area, kQuadLanes, &t.area[at]);
@@ -906,7 +931,10 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, boo
     ledger.contact = 0.0;
     return;
   }
-  displace_live_pieces(model);
+  // The one-by-one displacements serve the ordered clipping only: the other pieces, and the
+  // joints' energy.
+  if (with_energy || !other_live_.empty()) displace_live_pieces(model);
+  pose_bodies(model);
   overlap_pieces(with_energy);
   const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
   double* fx = r.fx.data();
@@ -981,6 +1009,7 @@ std::vector<BlockPairForce> RigidContact::pair_forces(const Model& model, double
   if (copy.needs_detection(model)) copy.detect(model);
   const RigidBodies& r = model.rigid;
   copy.displace_live_pieces(model);
+  copy.pose_bodies(model);
   copy.overlap_pieces(true);
   const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
   PairOut out;

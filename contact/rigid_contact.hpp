@@ -286,10 +286,19 @@ class RigidContact {
   // others; the slot of each live pair in overlap_.
   std::vector<Index> quad_live_, other_live_, slot_of_live_;
   // Per batch of quadrilateral pairs: the vertices' reference positions relative to P's first
-  // (QuadPairs without the displacements; ox, oy: P's first vertex), and per lane the first
-  // vertex of P and of Q in ref_ and disp_ (-1: an unused lane).
+  // vertex (QuadPairs without the displacements; ox, oy: P's first vertex).
   std::vector<QuadPairs> quad_ref_;
-  std::vector<Index> quad_p_, quad_q_;
+  // Per batch, the vertices' offsets from their bodies' reference centroids (offset_; zeros for
+  // bodies without a pose), and per lane the body of P and of Q that has a pose (the number of
+  // blocks, whose pose is zero: none, or an unused lane). The steps place the batches from the
+  // bodies' poses (quad_place), without displacing the vertices one by one.
+  std::vector<QuadPairs> quad_offset_;
+  std::vector<Index> quad_body_p_, quad_body_q_;
+  // Per block with a pose (moves_), this step's: the centroid's displacement, cos(theta) - 1 and
+  // sin(theta), as displace_live_pieces computes them; zeros for the others and, after the
+  // blocks, for a lane without a body.
+  std::vector<double> pose_ux_, pose_uy_, pose_cm1_, pose_s_;
+  void pose_bodies(const Model& model);
 
   // Ledger: per body (3 values: x, y, rotation) the dashpot and friction forces of this and of
   // the last step.
