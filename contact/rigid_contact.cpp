@@ -934,7 +934,7 @@ void RigidContact::add_forces(Model& model, double dt, EnergyLedger& ledger, boo
   // The one-by-one displacements serve the ordered clipping only: the other pieces, and the
   // joints' energy.
   if (with_energy || !other_live_.empty()) displace_live_pieces(model);
-  pose_bodies(model);
+  if (!quad_ref_.empty()) pose_bodies(model);
   overlap_pieces(with_energy);
   const BodyView bodies{r.cx.data(), r.cy.data(), r.vx.data(), r.vy.data(), r.omega.data()};
   double* fx = r.fx.data();
