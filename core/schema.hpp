@@ -120,6 +120,9 @@ struct BaseConfig {
 struct LoadConfig {
   double gravity = 9.81;               // [m/s2]
   double lambda = 0.0;                 // horizontal body load factor (x gravity)
+  // [s] `run`: gravity and lambda g brought on together, linearly, over this time (0: from
+  // t = 0). The other commands ramp gravity by their settle's own ramp time.
+  double gravity_ramp = 0.0;
   BaseConfig base;
 };
 

@@ -131,8 +131,9 @@ void draw_current_state(const Simulation& sim, const std::string& title,
 int command_run(const Config& config, const CommonOptions& common, const RunOptions& opts) {
   SetupInfo info;
   Simulation sim = make_simulation(config, &info);
-  // One physical history: gravity from t = 0 and the supports moving over [0, supports.ramp]
-  // (core/supports.hpp); the quasi-static commands move them after their settle instead.
+  // One physical history: gravity from t = 0 (over [0, load.gravity_ramp] when the deck ramps
+  // it) and the supports moving over [0, supports.ramp] (core/supports.hpp); the quasi-static
+  // commands move them after their settle instead.
   if (!sim.supports.empty()) start_support_motion(sim.supports, 0.0, config.supports.ramp);
   return run_simulation(sim, info, config, common, opts);
 }
@@ -197,6 +198,7 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
   LoadProgram loads;
   loads.gravity = config.load.gravity;
   loads.lambda = config.load.lambda;
+  loads.gravity_ramp = loads.lambda_ramp = config.load.gravity_ramp;
   loop.loads = loads;
   if (checkpoints) {
     loop.checkpoint_every = opts.checkpoint_every;

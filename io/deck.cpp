@@ -374,6 +374,7 @@ const std::vector<KeySpec>& key_table() {
       // [load]
       {"load.gravity", [](Reader& r, const toml::node& n, Config& c) { c.load.gravity = r.number(n, at_least(0), "m/s2"); }},
       {"load.lambda", [](Reader& r, const toml::node& n, Config& c) { c.load.lambda = r.number(n, any_finite(), "x gravity"); }},
+      {"load.gravity_ramp", [](Reader& r, const toml::node& n, Config& c) { c.load.gravity_ramp = r.number(n, at_least(0), "s"); }},
       // [load.base]
       {"load.base.signal", [](Reader& r, const toml::node& n, Config& c) { c.load.base.signal = r.choice(n, {"none", "windowed_sine", "sine_pulse", "file"}); }},
       {"load.base.amplitude", [](Reader& r, const toml::node& n, Config& c) { c.load.base.amplitude = r.number(n, any_finite(), "g"); }},

@@ -91,6 +91,10 @@ const std::map<std::string, std::string>& meanings() {
       // [load]
       {"load.gravity", "gravity g, downward"},
       {"load.lambda", "horizontal body load factor of `run` (x gravity)"},
+      {"load.gravity_ramp",
+       "`run`: gravity and lambda g brought on together, linearly, over this time (0: from "
+       "t = 0; a structure loaded over a time long against its slowest mode starts its history "
+       "at rest: docs/rigid.md)"},
       {"load.base.signal", "base acceleration history of `run` and `pulse`"},
       {"load.base.amplitude", "peak base acceleration A"},
       {"load.base.frequency", "pulse frequency f"},
@@ -207,6 +211,7 @@ std::string default_of(const std::string& key) {
       {"solver.end_time", number(c.solver.end_time)},
       {"load.gravity", number(c.load.gravity)},
       {"load.lambda", number(c.load.lambda)},
+      {"load.gravity_ramp", number(c.load.gravity_ramp)},
       {"load.base.signal", quoted(c.load.base.signal)},
       {"load.base.amplitude", number(c.load.base.amplitude)},
       {"load.base.frequency", number(c.load.base.frequency)},

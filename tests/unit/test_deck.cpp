@@ -77,6 +77,7 @@ end_time = 2.5
 [load]
 gravity = 9.8
 lambda = 0.3
+gravity_ramp = 0.2
 
 [load.base]
 signal = "windowed_sine"
@@ -190,6 +191,7 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.solver.end_time, 2.5);
   EXPECT_DOUBLE_EQ(c.load.gravity, 9.8);
   EXPECT_DOUBLE_EQ(c.load.lambda, 0.3);
+  EXPECT_DOUBLE_EQ(c.load.gravity_ramp, 0.2);
   EXPECT_EQ(c.load.base.signal, "windowed_sine");
   EXPECT_DOUBLE_EQ(c.load.base.amplitude, 0.4);
   EXPECT_DOUBLE_EQ(c.load.base.frequency, 5.0);

@@ -149,6 +149,37 @@ TEST(ThrustOutput, RunHdf5JointsAreTheJsonJointsAtTheFinalSnapshot) {
   EXPECT_GT(closed, 6);
 }
 
+// load.gravity_ramp: `run` brings gravity and lambda g on together, linearly. A rigid block on
+// its joint (its joint's period is 1e-4 s, so a ramp of 0.2 s is quasi-static) carries at
+// t = 0.1 s half its weight, W = rho b h g, and a shear of lambda times that; a negative ramp is
+// refused naming the key.
+TEST(ThrustOutput, RunRampsGravityAndLambdaTogether) {
+  const fs::path dir = scratch_dir();
+  const std::string json = (dir / "run.json").string();
+  const auto r = testing::run_process(
+      {VOUSSOIR_BINARY, "run", source("cases/block.toml"), "-q", "--set",
+       "material.model=\"rigid\"", "--set", "load.gravity_ramp=0.2", "--set", "load.lambda=0.2",
+       "--set", "solver.end_time=0.1", "-o", (dir / "run.h5").string(), "--json", json},
+      {}, (dir / "child").string());
+  ASSERT_TRUE(r.exited && r.status == 0) << r.describe() << r.err;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j.at("joints").size(), 1u);
+  const double weight = 2000.0 * 0.5 * 1.0 * 9.81;  // cases/block.toml, out-of-plane 1 m
+  const double t = j.at("end_time").get<double>();
+  const double normal = j["joints"][0]["normal_force"].get<double>();
+  const double shear = j["joints"][0]["shear_force"].get<double>();
+  EXPECT_NEAR(normal, weight * t / 0.2, 1e-3 * weight);
+  EXPECT_NEAR(std::abs(shear), 0.2 * normal, 1e-3 * normal);
+
+  const auto bad = testing::run_process(
+      {VOUSSOIR_BINARY, "run", source("cases/block.toml"), "-q", "--set", "load.gravity_ramp=-1"},
+      {}, (dir / "bad").string());
+  EXPECT_TRUE(bad.exited && bad.status == 2) << bad.describe();
+  EXPECT_NE(bad.err.find("load.gravity_ramp"), std::string::npos) << bad.err;
+  fs::remove_all(dir);
+}
+
 // pulse --picture: the shaking-table arch after a small 12 Hz pulse (survived) is drawn to a
 // PNG; with --curve the option is refused (exit 2) before any run.
 TEST(ThrustOutput, PulsePictureDrawsTheFinalStateAndIsRefusedWithTheCurve) {
