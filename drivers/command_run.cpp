@@ -131,6 +131,11 @@ void draw_current_state(const Simulation& sim, const std::string& title,
 int command_run(const Config& config, const CommonOptions& common, const RunOptions& opts) {
   SetupInfo info;
   Simulation sim = make_simulation(config, &info);
+  if (config.load.base.signal != "none" && !common.quiet)
+    std::fprintf(stderr,
+                 "run: the deck's base signal (load.base.signal = \"%s\") is not applied by "
+                 "`run`; `pulse` runs it\n",
+                 config.load.base.signal.c_str());
   // One physical history: gravity from t = 0 (over [0, load.gravity_ramp] when the deck ramps
   // it) and the supports moving over [0, supports.ramp] (core/supports.hpp); the quasi-static
   // commands move them after their settle instead.

@@ -95,7 +95,7 @@ const std::map<std::string, std::string>& meanings() {
        "`run`: gravity and lambda g brought on together, linearly, over this time (0: from "
        "t = 0; a structure loaded over a time long against its slowest mode starts its history "
        "at rest: docs/rigid.md)"},
-      {"load.base.signal", "base acceleration history of `run` and `pulse`"},
+      {"load.base.signal", "base acceleration history of `pulse` (`run` does not apply it)"},
       {"load.base.amplitude", "peak base acceleration A"},
       {"load.base.frequency", "pulse frequency f"},
       {"load.base.cycles", "windowed sine: number of cycles"},
