@@ -713,7 +713,9 @@ void RigidContact::displace_pieces(const Model& model, const std::vector<double>
 }
 
 // displace_pieces for the pieces of the live pairs, at the bodies' current poses (the same
-// numbers, with the offsets r computed at the detection).
+// numbers, with the offsets r computed at the detection). (Rejected: reading pose_bodies'
+// arrays instead of its own half angles. The values are the same, but loaded from memory the
+// compiler fuses the products of u differently, and the scaled arch's pulses moved by round-off.)
 void RigidContact::displace_live_pieces(const Model& model) {
   const double* ux = model.rigid.ux.data();
   const double* uy = model.rigid.uy.data();
