@@ -171,6 +171,11 @@ struct ContactSystem::Impl {
   // does all the work; the triangle-pair machinery below stays idle.
   bool rigid_mode = false;
   RigidContact rigid;
+  // Rigid blocks by non-smooth contact dynamics (ContactParams::nscd): points and impulses
+  // (contact/nscd.hpp) on RigidContact's detection; its joint law stays idle.
+  bool nscd_mode = false;
+  NscdContact nscd;
+  std::int64_t nscd_active = 0;  // points with an impulse at the last solve
 
   // Candidate pairs (triangle ids, sorted) and their friction state.
   std::vector<IndexPair> pairs, next_pairs;
@@ -315,6 +320,9 @@ void ContactSystem::setup(const Model& model, const ContactParams& params) {
   }
   s.rigid_mode = model.is_rigid();
   if (s.rigid_mode) s.rigid.setup(model, params, s.penalty, buffer, s.block_min_height);
+  s.nscd_mode = s.rigid_mode && params.nscd;
+  if (s.nscd_mode) s.nscd.setup(model, s.rigid, s.rigid.buffer());
+  s.nscd_active = 0;
   s.ready = true;
 }
 
@@ -501,11 +509,22 @@ constexpr std::uint64_t kStateTag1 = 0x564f555353434f31ull;  // "VOUSSCO1": no d
 constexpr std::uint64_t kStateTag2 = 0x564f555353434f32ull;  // "VOUSSCO2": no friction arrays
 constexpr std::uint64_t kStateTag3 = 0x564f555353434f33ull;  // "VOUSSCO3": |f| dashpot state
 constexpr std::uint64_t kStateTag = 0x564f555353434f34ull;   // "VOUSSCO4"
+// Rigid blocks by non-smooth contact dynamics: the active count, RigidContact's bytes, then
+// NscdContact's.
+constexpr std::uint64_t kNscdStateTag = 0x564f5553534e5331ull;  // "VOUSSNS1"
 
 }  // namespace
 
 std::vector<char> ContactSystem::save_state() const {
   const Impl& s = *impl_;
+  if (s.nscd_mode) {
+    std::vector<char> out;
+    put(out, kNscdStateTag);
+    put<std::int64_t>(out, s.nscd_active);
+    put_array(out, s.rigid.save_state());
+    put_array(out, s.nscd.save_state());
+    return out;
+  }
   if (s.rigid_mode) return s.rigid.save_state();
   std::vector<char> out;
   put(out, kStateTag);
@@ -529,6 +548,18 @@ std::vector<char> ContactSystem::save_state() const {
 
 void ContactSystem::restore_state(const Model& model, const std::vector<char>& bytes) {
   Impl& s = *impl_;
+  if (s.nscd_mode) {
+    StateReader in{bytes};
+    if (in.get<std::uint64_t>() != kNscdStateTag)
+      in.fail("not a non-smooth contact state (written by the explicit scheme?)");
+    const auto active = in.get<std::int64_t>();
+    const std::vector<char> rigid = in.get_array<char>(), nscd = in.get_array<char>();
+    if (in.pos != bytes.size()) in.fail("unexpected data after the non-smooth contact state");
+    s.rigid.restore_state(model, rigid);
+    s.nscd.restore_state(nscd);
+    s.nscd_active = active;
+    return;
+  }
   if (s.rigid_mode) {
     s.rigid.restore_state(model, bytes);
     return;
@@ -865,8 +896,27 @@ void ContactSystem::add_forces(Model& model, double dt, EnergyLedger& ledger, bo
        : s.accumulate<false, false>(model, dt, ledger);
 }
 
+bool ContactSystem::nscd_mode() const {
+  return impl_->nscd_mode;
+}
+
+void ContactSystem::build_contact_points(const Model& model) {
+  Impl& s = *impl_;
+  if (s.ready && s.nscd_mode) s.nscd.build(model, s.rigid);
+}
+
+NscdStepResult ContactSystem::solve_impulses(Model& model, const std::vector<double>& before,
+                                             double h, Vec2 load, const NscdSettings& settings) {
+  Impl& s = *impl_;
+  if (!s.ready || !s.nscd_mode) return {};
+  const NscdStepResult r = s.nscd.solve(model, before, h, load, settings);
+  s.nscd_active = r.active;
+  return r;
+}
+
 std::vector<BlockPairForce> ContactSystem::block_pair_forces(const Model& model, double dt) const {
   if (!impl_->ready || !impl_->rigid_mode) return {};
+  if (impl_->nscd_mode) return impl_->nscd.pair_forces(model, dt);
   return impl_->rigid.pair_forces(model, dt);
 }
 
@@ -985,6 +1035,7 @@ std::int64_t ContactSystem::candidate_pairs() const {
   return static_cast<std::int64_t>(impl_->pairs.size());
 }
 std::int64_t ContactSystem::active_pairs() const {
+  if (impl_->nscd_mode) return impl_->nscd_active;
   if (impl_->rigid_mode) return impl_->rigid.active_pairs();
   return impl_->active;
 }

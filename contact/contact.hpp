@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "contact/nscd.hpp"
 #include "contact/rigid_contact.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
@@ -30,6 +31,10 @@ struct ContactParams {
   // damping (contact/joint_stiffness.hpp). Rigid blocks only: on elastic blocks the dashpot
   // would be tuned to the joint's low frequency and overdamp the element modes that share it.
   double restitution = 1.0;
+  // Rigid blocks by non-smooth contact dynamics (solver.scheme = "nscd", contact/nscd.hpp):
+  // contact points and impulses instead of the joint law's forces; the stiffness keys above
+  // do not apply.
+  bool nscd = false;
 };
 
 // Highest contact frequency bound and the damping rate (c/m) of that mode [1/s2, 1/s], for the
@@ -74,13 +79,22 @@ class ContactSystem {
   // (StepContext::contact_energy); elastic blocks always set it.
   void add_forces(Model& model, double dt, EnergyLedger& ledger, bool energy = true);
 
+  // Non-smooth contact dynamics (ContactParams::nscd; contact/nscd.hpp): the contact points at
+  // the bodies' current poses (after the broad phase), then the step's impulses from the
+  // bodies' free velocities (NscdContact::solve).
+  bool nscd_mode() const;
+  void build_contact_points(const Model& model);
+  NscdStepResult solve_impulses(Model& model, const std::vector<double>& before, double h,
+                                Vec2 load, const NscdSettings& settings);
+
   // The force of every touching pair at the current node positions and velocities, in pair
   // order: what the next add_forces would apply, evaluated on a copy of this system (detection
   // when needed, then the narrow phase and friction), so the run's state and its forces are
   // untouched. For reports (drivers/thrust.hpp), never called inside the step.
   std::vector<TouchingPair> pair_forces(const Model& model, double dt) const;
   // Rigid blocks: the force of every touching block pair (contact/rigid_contact.hpp), the same
-  // way; empty for elastic blocks (pair_forces serves them).
+  // way (by non-smooth contact dynamics: the last step's impulses / dt); empty for elastic
+  // blocks (pair_forces serves them).
   std::vector<BlockPairForce> block_pair_forces(const Model& model, double dt) const;
   // True when the blocks are rigid and touch by their outlines.
   bool rigid_outlines() const;

@@ -1077,4 +1077,24 @@ void RigidContact::restore_state(const Model& model, const std::vector<char>& by
   active_ = active;
 }
 
+int RigidContact::piece_reference(Index k, Vec2* out) const {
+  const Index first = piece_first_[std::size_t(k)], last = piece_first_[std::size_t(k) + 1];
+  for (Index v = first; v < last; ++v) out[v - first] = ref_[std::size_t(v)];
+  return int(last - first);
+}
+
+int RigidContact::piece_vertices(const Model& model, Index k, Vec2* out) const {
+  const int n = piece_reference(k, out);
+  const std::size_t b = std::size_t(piece_block_[std::size_t(k)]);
+  if (!has_pose(model, b)) return n;
+  const RigidBodies& r = model.rigid;
+  const double c = std::cos(r.theta[b]), s = std::sin(r.theta[b]);
+  const double cx = r.cx0[b] + r.ux[b], cy = r.cy0[b] + r.uy[b];
+  for (int i = 0; i < n; ++i) {
+    const double rx = out[i].x - r.cx0[b], ry = out[i].y - r.cy0[b];
+    out[i] = {cx + c * rx - s * ry, cy + s * rx + c * ry};
+  }
+  return n;
+}
+
 }  // namespace voussoir

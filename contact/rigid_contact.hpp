@@ -185,6 +185,18 @@ class RigidContact {
   std::vector<char> save_state() const;
   void restore_state(const Model& model, const std::vector<char>& bytes);
 
+  // What the non-smooth contact dynamics reads (contact/nscd.hpp): the convex pieces, the
+  // live pairs of pieces of the last detection (pair l: a piece of the lower block, one of the
+  // higher), and a piece's vertices, counter-clockwise, in the reference configuration or at
+  // the bodies' poses in `model` (returns the count, at most kMaxPieceVertices).
+  Index piece_count() const { return Index(piece_block_.size()); }
+  Index piece_block(Index k) const { return piece_block_[std::size_t(k)]; }
+  std::size_t live_pairs() const { return live_i_.size(); }
+  Index live_piece_a(std::size_t l) const { return live_i_[l]; }
+  Index live_piece_b(std::size_t l) const { return live_j_[l]; }
+  int piece_reference(Index k, Vec2* out) const;
+  int piece_vertices(const Model& model, Index k, Vec2* out) const;
+
  private:
   struct PairOut {
     Vec2 fb;                    // all forces on b [N]

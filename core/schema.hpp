@@ -101,6 +101,14 @@ struct SolverConfig {
   double dt_safety = 0.9;
   double damping_factor = 1.0;         // scales eta = 2 h sqrt(E rho)
   double end_time = 1.0;               // [s]
+  // "explicit" (central difference, every kind of block) or "nscd" (rigid blocks by
+  // non-smooth contact dynamics, contact/nscd.hpp; docs/nscd.md)
+  std::string scheme = "explicit";
+  // nscd: Moreau-Jean's theta in [0.5, 1]; the Gauss-Seidel's relative tolerance on the
+  // impulses and its iteration cap per step
+  double theta = 0.5;
+  double tolerance = 1e-6;
+  int max_iterations = 1000;
 };
 
 struct BaseConfig {

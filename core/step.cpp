@@ -120,7 +120,96 @@ InertiaScaling equalize_rigid_inertia(Simulation& sim) {
   return out;
 }
 
+namespace {
+
+// Moreau-Jean's theta-method for rigid blocks (core/step.hpp; the impulses and their work:
+// contact/nscd.hpp). Ledger: the kinetic energy at the end of the step; the loads' work over
+// the step's displacement, h M a . ((1 - theta) v^- + theta v^+); the impulses' work booked
+// as impact and friction dissipation and the supports' work as external work (nscd.hpp
+// "Energy"); and the theta-method's own dissipation, the loads' work less h M a . (v^- + v^+)
+// / 2 (zero at theta = 1/2), as damping dissipation. The balance then holds to round-off.
+void advance_nscd(Simulation& sim) {
+  Model& model = sim.model;
+  StepContext& ctx = sim.ctx;
+  EnergyLedger& ledger = sim.ledger;
+  StageTimers& timers = sim.timers;
+  StageClock clock(timers.enabled);
+  RigidBodies& r = model.rigid;
+  const double h = ctx.dt, theta = ctx.nscd_settings.theta;
+  const std::size_t nb = model.blocks.size();
+
+  // 1. broad phase when due, then the contact points at the start of the step
+  if (ctx.contact_on && sim.contact.needs_detection(model)) sim.contact.detect(model);
+  if (ctx.contact_on) sim.contact.build_contact_points(model);
+  clock.stamp(timers.broad);
+
+  // 2. prescribed supports: pose at the step's end and velocity over the step (no forces act
+  //    on the bodies here, so move_supports books no work; the impulses give it below)
+  if (!sim.supports.empty()) move_supports(model, sim.supports, ctx.time + h, h);
+
+  // 3. velocities at the start of the step, then the loads' impulse
+  std::vector<double>& before = sim.nscd_before;
+  before.resize(3 * nb);
+  double k0 = 0.0;
+  for (std::size_t b = 0; b < nb; ++b) {
+    before[3 * b] = r.vx[b], before[3 * b + 1] = r.vy[b], before[3 * b + 2] = r.omega[b];
+    if (model.blocks[b].fixed) continue;
+    k0 += r.mass[b] * (r.vx[b] * r.vx[b] + r.vy[b] * r.vy[b]) + r.inertia[b] * r.omega[b] * r.omega[b];
+    r.vx[b] += h * ctx.body_ax;
+    r.vy[b] += h * ctx.body_ay;
+  }
+  k0 *= 0.5;
+  clock.stamp(timers.loads);
+
+  // 4. contact impulses (v^+)
+  NscdStepResult solved;
+  if (ctx.contact_on) solved = sim.contact.solve_impulses(model, before, h, {ctx.body_ax, ctx.body_ay}, ctx.nscd_settings);
+  sim.nscd_stats.add(solved);
+  clock.stamp(timers.contact);
+
+  // 5. positions, kinetic energy, the loads' work
+  double k1 = 0.0, load_work = 0.0, mid_work = 0.0;
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (model.blocks[b].fixed) continue;
+    const double* v0 = &before[3 * b];
+    const double mx = (1.0 - theta) * v0[0] + theta * r.vx[b];
+    const double my = (1.0 - theta) * v0[1] + theta * r.vy[b];
+    const double mw = (1.0 - theta) * v0[2] + theta * r.omega[b];
+    r.ux[b] += h * mx;
+    r.uy[b] += h * my;
+    r.cx[b] = r.cx0[b] + r.ux[b];
+    r.cy[b] = r.cy0[b] + r.uy[b];
+    r.theta[b] += h * mw;
+    const double m = r.mass[b];
+    k1 += m * (r.vx[b] * r.vx[b] + r.vy[b] * r.vy[b]) + r.inertia[b] * r.omega[b] * r.omega[b];
+    load_work += h * m * (ctx.body_ax * mx + ctx.body_ay * my);
+    mid_work += 0.5 * h * m * (ctx.body_ax * (v0[0] + r.vx[b]) + ctx.body_ay * (v0[1] + r.vy[b]));
+  }
+  clock.stamp(timers.integrate);
+
+  if (sim.step == 0) ledger.external_work += k0;  // the initial state's energy (advance())
+  ledger.kinetic = 0.5 * k1;
+  ledger.strain = 0.0;
+  ledger.contact = 0.0;
+  ledger.external_work += load_work + solved.support_work;
+  ledger.impact_dissipated += solved.impact_dissipated;
+  ledger.friction_dissipated += solved.friction_dissipated;
+  ledger.damping_dissipated += load_work - mid_work;
+  ledger.update_max();
+
+  ctx.prev_body_ax = ctx.body_ax;
+  ctx.prev_body_ay = ctx.body_ay;
+  ctx.time += h;
+  ++sim.step;
+}
+
+}  // namespace
+
 void advance(Simulation& sim) {
+  if (sim.ctx.nscd) {
+    advance_nscd(sim);
+    return;
+  }
   Model& model = sim.model;
   StepContext& ctx = sim.ctx;
   EnergyLedger& ledger = sim.ledger;

@@ -14,6 +14,14 @@
 //      their kinetic damping when ctx.kinetic_damping > 0)
 //   7. prescribed supports: their work over the step, then their   core/supports
 //      pose at the step's end (only with [supports] moves)
+//
+// Rigid blocks by non-smooth contact dynamics (solver.scheme = "nscd", ctx.nscd) take the
+// other scheme, Moreau-Jean's theta-method (advance_nscd in core/step.cpp; contact/nscd.hpp):
+//   1. broad phase as above, then the contact points at the start of the step
+//   2. prescribed supports: their pose at the step's end and their velocity over it
+//   3. free velocities: v^- + h a(t + theta h) of the loads
+//   4. contact impulses by non-linear Gauss-Seidel, which give v^+      contact/nscd
+//   5. positions q^+ = q^- + h ((1 - theta) v^- + theta v^+); ledger from the impulses
 
 #include <array>
 #include <vector>
@@ -54,6 +62,14 @@ struct StepContext {
   // set by advance(), not by drivers.
   double prev_body_ax = 0.0;
   double prev_body_ay = 0.0;
+  // Non-smooth contact dynamics of rigid blocks (solver.scheme = "nscd"): advance() takes
+  // Moreau-Jean's theta-method with the settings of contact/nscd.hpp; false: the explicit
+  // central difference.
+  bool nscd = false;
+  NscdSettings nscd_settings;
+  // The load program evaluates the loads at ctx.time + load_lead [s] (drivers/trial.hpp
+  // LoadProgram): theta h for nscd (the theta-method's load), 0 for the explicit scheme.
+  double load_lead = 0.0;
 };
 
 // Wall-clock seconds spent per stage (accumulated).
@@ -87,6 +103,11 @@ struct Simulation {
   // Prescribed movement of fixed blocks ([supports]; empty: none), started by the drivers
   // after the settle under gravity (core/supports.hpp).
   SupportMotion supports;
+  // Non-smooth contact dynamics: the solver's record over the run (iterations, unconverged
+  // steps, residual, interpenetration) and the bodies' velocities at the start of the step
+  // (scratch, 3 per block).
+  NscdStats nscd_stats;
+  std::vector<double> nscd_before;
 };
 
 // Fills ctx law constants and eta from the model material and damping factor.

@@ -38,12 +38,16 @@ SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) 
   // The quasi-static phases damp every motion themselves: rigid joints take no dashpot there
   // unless the deck gives one (contact/joint_stiffness.hpp kRigidDefaultRestitution).
   Config config = given;
-  if (crit.quasi_static && !config.contact.has("restitution")) {
+  // Non-smooth contact dynamics needs no quasi-static technique: on rigid contacts a structure
+  // that can stand stands still, and the plastic impacts at its contact points take the energy
+  // out of a motion (docs/nscd.md "Capacity"); the trials are physical.
+  const bool quasi_static = crit.quasi_static && config.solver.scheme != "nscd";
+  if (quasi_static && !config.contact.has("restitution")) {
     config.contact.restitution = 1.0;
     config.contact.given.push_back("restitution");
   }
   s.sim = make_simulation(config);
-  if (crit.quasi_static) {
+  if (quasi_static) {
     s.sim.ctx.local_damping = config.capacity.local_damping;
     s.sim.ctx.local_damping_outgoing = config.capacity.local_damping_mode == "outgoing";
     s.sim.ctx.kinetic_damping = config.capacity.kinetic_damping;
@@ -68,12 +72,13 @@ SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) 
   spec.label = "the settle under gravity";
   spec.loads = LoadProgram{};
   spec.loads->gravity = s.gravity;
-  spec.loads->gravity_ramp = crit.ramp_time;
+  const double ramp = load_ramp(crit, sim);
+  spec.loads->gravity_ramp = ramp;
   spec.limits = crit.limits;
   spec.end_time = crit.settle_max_time;
   spec.track_motion = true;
   spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
-  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, crit.hold_time, ramp));
   spec.quiet = quiet;
   spec.progress = [&](const Probe& p, double wall) {
     std::fprintf(stderr,
@@ -98,6 +103,10 @@ SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) 
                  s.steps, sim.ctx.dt, s.wall_s, sim.ledger.balance_error());
   if (s.settled && !sim.supports.empty()) move_supports_settled(s, config, crit, quiet);
   return s;
+}
+
+double load_ramp(const TrialCriteria& crit, const Simulation& sim) {
+  return sim.ctx.nscd ? 0.0 : crit.ramp_time;
 }
 
 MotionExtent support_allowance(const SupportMotion& supports, double l_ref) {
@@ -276,16 +285,17 @@ RunSpec trial_spec(const SettledState& settled, double lambda, const TrialCriter
   spec.loads = LoadProgram{};
   spec.loads->gravity = g;
   spec.loads->lambda = crit.direction * lambda;
-  spec.loads->lambda_ramp = crit.ramp_time;
+  const double ramp = load_ramp(crit, settled.sim);
+  spec.loads->lambda_ramp = ramp;
   spec.loads->start = settled.sim.ctx.time;
   spec.limits = crit.limits;
   spec.track_motion = true;
   spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse, crit.collapse_rotation));
-  auto rest = std::make_unique<RestRule>(v_rest, crit.hold_time, crit.ramp_time);
+  auto rest = std::make_unique<RestRule>(v_rest, crit.hold_time, ramp);
   if (crit.quasi_static) rest->refuse_creep(d_collapse, crit.collapse_rotation, kCreepTolerance);
   spec.rules.push_back(std::move(rest));
   spec.rules.push_back(std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0,
-                                                   crit.ramp_time, crit.max_time));
+                                                   ramp, crit.max_time));
   spec.quiet = quiet;
   const double rot_limit = crit.collapse_rotation;
   spec.progress = [lambda, d_collapse, v_rest, rot_limit](const Probe& p, double wall) {
@@ -348,7 +358,8 @@ MovieReport record_trial(const SettledState& settled, double lambda, const Trial
   spec.sample_at_start = true;
   spec.on_sample = [&](const Simulation& s, const Probe& p) {
     if (p.time >= next_frame - 0.5 * s.ctx.dt) {
-      const double ramp = crit.ramp_time > 0.0 ? std::min(1.0, p.time / crit.ramp_time) : 1.0;
+      const double ramp_time = load_ramp(crit, s);
+      const double ramp = ramp_time > 0.0 ? std::min(1.0, p.time / ramp_time) : 1.0;
       writer.write_snapshot(p.time, s.model, {});
       write_snapshot_thrust(writer, s.model, s.contact, s.ctx.dt, lambda * ramp);
       next_frame += frame_every;

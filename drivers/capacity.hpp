@@ -85,6 +85,12 @@ struct TrialCriteria {
   RunLimits limits;                    // guards and the user's limits (drivers/trial.hpp)
 };
 
+// The load ramp of a settle or a trial [s]: crit.ramp_time, and none under non-smooth contact
+// dynamics. On rigid contacts a load below the capacity moves nothing however fast it comes
+// (nothing stores energy to give back), and the contact solver converges in fewer sweeps from
+// one change of the load than from a hundred small ones (docs/nscd.md "Capacity").
+double load_ramp(const TrialCriteria& crit, const Simulation& sim);
+
 struct TrialResult {
   double lambda = 0.0;
   bool collapsed = false;

@@ -124,8 +124,19 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   std::printf("blocks are  %s\n", info.rigid ? "rigid (one body each; no strain energy, no stress "
                                                "field)"
                                              : "elastic (constant-strain triangles)");
-  std::printf("dt          %.4g s (stable limit %.4g s, set by the %s)\n", info.dt, info.dt_stable,
-              info.dt_set_by.c_str());
+  if (sim.ctx.nscd) {
+    // Non-smooth contact dynamics: no stiffness, no stable limit (docs/nscd.md).
+    std::printf("scheme      nscd: Moreau-Jean theta = %g, rigid contact points, Gauss-Seidel to "
+                "%g (at most %d sweeps a step)\n",
+                config.solver.theta, config.solver.tolerance, config.solver.max_iterations);
+    std::printf("dt          %.4g s (set by the %s)\n", info.dt, info.dt_set_by.c_str());
+    std::printf("restitution %.3g (%s)\n", sim.contact.params().restitution,
+                config.contact.has("restitution") ? "contact.restitution"
+                                                  : "plastic impacts, the nscd default");
+  } else {
+    std::printf("dt          %.4g s (stable limit %.4g s, set by the %s)\n", info.dt,
+                info.dt_stable, info.dt_set_by.c_str());
+  }
   // Rigid blocks: how far the blocks' own stable limits spread. The step is the smallest; a
   // narrow spread means that no mass scaling of a few fast blocks could lengthen it much.
   const std::vector<double> each_body = rigid_body_stable_steps(sim);
@@ -135,13 +146,15 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   std::sort(body_steps.begin(), body_steps.end());
   const std::size_t fastest =
       std::size_t(std::min_element(each_body.begin(), each_body.end()) - each_body.begin());
-  if (!body_steps.empty()) {
+  if (!body_steps.empty() && !sim.ctx.nscd) {
     std::printf(
         "body steps  min %.4g s (block %zu), median %.4g s, max %.4g s: each free block "
         "alone on its joints\n",
         body_steps.front(), fastest, body_steps[body_steps.size() / 2], body_steps.back());
   }
-  if (info.joint_stiffness) {
+  if (sim.ctx.nscd) {
+    // no joint stiffness, no penalty, no impact dashpot
+  } else if (info.joint_stiffness) {
     if (config.contact.normal_stiffness > 0.0)
       std::printf("joints      kn = %.4g N/m3, ks = %.4g N/m3\n", config.contact.normal_stiffness,
                   config.contact.shear_stiffness > 0.0
@@ -154,7 +167,7 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   } else {
     std::printf("penalty     %.4g Pa\n", info.penalty);
   }
-  if (sim.contact.params().restitution < 1.0)
+  if (sim.contact.params().restitution < 1.0 && !sim.ctx.nscd)
     std::printf("restitution %.3g (impact damping%s)\n", sim.contact.params().restitution,
                 config.contact.has("restitution")
                     ? ""

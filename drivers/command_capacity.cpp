@@ -14,6 +14,7 @@
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plot.hpp"
+#include "drivers/solver_report.hpp"
 #include "io/hdf5_output.hpp"
 #include "io/json.hpp"
 
@@ -241,11 +242,15 @@ int command_capacity(const Config& config, const CommonOptions& common,
     }
   }
 
+  const NscdStats solver = solver_record();
+  warn_unconverged(config, solver, common.quiet);
   if (!common.json_path.empty()) {
     nlohmann::json j = capacity_json(results[governing], opts);
+    const bool quasi_static = criteria.quasi_static && config.solver.scheme != "nscd";
     j["direction"] = directions[governing];
-    j["quasi_static"] = criteria.quasi_static;
-    j["mass_scaling"] = criteria.quasi_static ? config.capacity.mass_scaling : "none";
+    j["quasi_static"] = quasi_static;
+    j["mass_scaling"] = quasi_static ? config.capacity.mass_scaling : "none";
+    j["solver"] = solver_json(config, solver);
     if (results.size() > 1) {
       nlohmann::json each = nlohmann::json::object();
       for (std::size_t i = 0; i < results.size(); ++i)

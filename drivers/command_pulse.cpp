@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/spectrum.hpp"
+#include "drivers/solver_report.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/dealer.hpp"
 #include "drivers/plot.hpp"
@@ -229,6 +230,7 @@ int single_run(const Config& config, const CommonOptions& common, const PulseOpt
                         {"settle_wall_s", settled.wall_s},
                         {"wall_s", wall},
                         {"output", out_path}};
+    j["solver"] = solver_json(config, solver_record());
     write_json(j, common.json_path);
   }
   return 0;
@@ -405,6 +407,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
         {"ranks", rank_count()},
         {"wall_s", wall}};
     if (opts.tilt_reference_given) j["tilt_reference"] = opts.tilt_reference;
+    j["solver"] = solver_json(config, solver_record());
     write_json(j, common.json_path);
   }
   for (const std::string& e : errors)

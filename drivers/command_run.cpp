@@ -22,6 +22,7 @@
 #include "drivers/plot.hpp"
 #include "drivers/run.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/solver_report.hpp"
 #include "drivers/thrust.hpp"
 #include "io/checkpoint.hpp"
 #include "io/deck.hpp"
@@ -236,6 +237,7 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
       static_cast<long long>(sim.contact.active_pairs()),
       static_cast<long long>(stats.max_active_pairs));
   if (write) std::printf("output %s (+ %s)\n", out_path.c_str(), writer.xdmf_path().c_str());
+  warn_unconverged(config, sim.nscd_stats, common.quiet);
   if (!opts.picture.empty()) {
     char title[96];
     std::snprintf(title, sizeof title, "end of the run: t = %.4g s, lambda = %.4g", sim.ctx.time,
@@ -267,6 +269,7 @@ int run_simulation(Simulation& sim, const SetupInfo& info, const Config& config,
                         {"output", out_path}};
     // The line of thrust at the end of the run (drivers/thrust.hpp; the run's state untouched).
     j["joints"] = joints_json(joint_resultants(sim.model, sim.contact, sim.ctx.dt));
+    j["solver"] = solver_json(config, sim.nscd_stats);
     if (checkpoints) j["checkpoint"] = ckpt_path;
     if (!opts.restart.empty()) j["restarted_from"] = opts.restart;
     write_json(j, common.json_path);

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/fnv.hpp"
+#include "drivers/solver_report.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/dealer.hpp"
 #include "drivers/plot.hpp"
@@ -157,6 +158,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
     }
     write_json({{"cells", jcells},
                 {"axes", jaxes},
+                {"solver", solver_json(grid.configs.front(), solver_record())},
                 {"criteria",
                  {{"ramp_time", crit.trial.ramp_time},
                   {"collapse_displacement", crit.trial.collapse_displacement},

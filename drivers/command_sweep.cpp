@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/fnv.hpp"
+#include "drivers/solver_report.hpp"
 #include "drivers/capacity.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/dealer.hpp"
@@ -181,7 +182,11 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("sweep of %zu cells written to %s (%.1f s wall)\n", cells, csv_path.c_str(), wall);
   if (!common.json_path.empty())
-    write_json({{"cells", jcells}, {"csv", csv_path}, {"ranks", rank_count()}, {"wall_s", wall}},
+    write_json({{"cells", jcells},
+                {"csv", csv_path},
+                {"ranks", rank_count()},
+                {"wall_s", wall},
+                {"solver", solver_json(grid.configs.front(), solver_record())}},
                common.json_path);
   if (!opts.plot.empty()) {
     draw_with_script("plot_sweep", {csv_path, "-o", opts.plot}, opts.plot);

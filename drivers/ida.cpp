@@ -1,5 +1,6 @@
 // `voussoir ida`: incremental dynamic analysis and the fragility of collapse (ida.hpp).
 
+#include "drivers/solver_report.hpp"
 #include "drivers/ida.hpp"
 
 #include <algorithm>
@@ -327,6 +328,7 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
                         {"ranks", rank_count()},
                         {"wall_s", wall}};
     if (!fit.ok) j["fragility_missing"] = fit.why;
+    j["solver"] = solver_json(config, solver_record());
     write_json(j, common.json_path);
   }
   for (const SearchOutcome& out : outcomes)

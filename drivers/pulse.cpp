@@ -110,6 +110,7 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
                       const std::function<void(const Simulation&)>& at_end) {
   const auto wall0 = Clock::now();
   Simulation sim = settled.sim;  // deep copy
+  fit_step_to_signal(sim, signal);  // nscd: no step longer than a record's sampling interval
   const double g = settled.gravity;
   const double dt = sim.ctx.dt;
   const long long step0 = sim.step;
@@ -122,7 +123,7 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   LoadProgram loads;
   loads.gravity = g;
   loads.lambda = lambda;
-  loads.lambda_ramp = crit.settle.ramp_time;
+  loads.lambda_ramp = load_ramp(crit.settle, sim);
   loads.start = sim.ctx.time;
   if (lambda != 0.0) {
     RunSpec ramp;
@@ -131,7 +132,7 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
     ramp.limits = crit.settle.limits;
     ramp.sample_every = crit.sample_time;
     ramp.sample_origin = step0;
-    ramp.end_time = crit.settle.ramp_time;
+    ramp.end_time = std::max(load_ramp(crit.settle, sim), dt);
     run_engine(sim, ramp);
   }
 

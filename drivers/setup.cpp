@@ -1,12 +1,14 @@
 #include "drivers/setup.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "contact/joint_stiffness.hpp"
 #include "core/cst.hpp"
 #include "core/rigid.hpp"
 #include "core/supports.hpp"
+#include "io/accelerogram.hpp"
 #include "io/deck.hpp"
 #include "mesh/minimal.hpp"
 #include "mesh/scene.hpp"
@@ -72,7 +74,10 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   cp.normal_stiffness = config.contact.normal_stiffness;
   cp.shear_stiffness = config.contact.shear_stiffness;
   cp.restitution = config.contact.restitution;
-  if (rigid && !config.contact.has("restitution")) cp.restitution = kRigidDefaultRestitution;
+  const bool nscd = config.solver.scheme == "nscd";
+  cp.nscd = nscd;
+  if (rigid && !config.contact.has("restitution"))
+    cp.restitution = nscd ? kNscdDefaultRestitution : kRigidDefaultRestitution;
   // Rigid blocks with neither a stiffness nor a penalty given: kn = 100 E / L per joint (L:
   // its length; contact/joint_stiffness.hpp).
   if (rigid && !(cp.normal_stiffness > 0.0) && !config.contact.has("penalty") &&
@@ -81,6 +86,28 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   sim.contact.setup(sim.model, cp);
   prepare_context(sim, config.solver.damping_factor);
   set_static_load(sim, config.load.gravity, config.load.lambda);
+  if (nscd) {
+    // Moreau-Jean's step is not limited by any stiffness: the deck's, or kNscdDefaultStep, no
+    // longer than a record's sampling interval (fit_step_to_signal).
+    sim.ctx.nscd = true;
+    sim.ctx.nscd_settings = {config.solver.theta, config.solver.tolerance,
+                             config.solver.max_iterations, cp.friction, cp.restitution};
+    sim.ctx.dt = config.solver.dt > 0.0 ? config.solver.dt : kNscdDefaultStep;
+    sim.ctx.load_lead = config.solver.theta * sim.ctx.dt;
+    if (config.solver.dt == 0.0 && config.load.base.signal == "file")
+      fit_step_to_signal(sim, make_base_signal(config.load.base, config.load.gravity));
+    if (info) {
+      info->dt = sim.ctx.dt;
+      info->dt_stable = std::numeric_limits<double>::infinity();
+      info->penalty = 0.0;
+      info->eta = 0.0;
+      info->rigid = true;
+      info->joint_stiffness = false;
+      info->dt_set_by = config.solver.dt > 0.0 ? "solver.dt (non-smooth contact dynamics)"
+                                               : "non-smooth contact dynamics (solver.dt = \"auto\")";
+    }
+    return sim;
+  }
 
   const double dt_stable = stable_time_step(sim);
   // Infinite when nothing can vibrate (no free block); zero or NaN only when the material,
@@ -121,6 +148,13 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
                             : "elements and contact penalty";
   }
   return sim;
+}
+
+void fit_step_to_signal(Simulation& sim, const BaseSignal& signal) {
+  if (!sim.ctx.nscd || signal.kind() != BaseSignal::Kind::Table) return;
+  if (!(signal.sample_dt() < sim.ctx.dt)) return;
+  sim.ctx.dt = signal.sample_dt();
+  sim.ctx.load_lead = sim.ctx.nscd_settings.theta * sim.ctx.dt;
 }
 
 std::vector<double> triangle_stresses(const Simulation& sim) {

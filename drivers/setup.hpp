@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base_motion.hpp"
 #include "core/step.hpp"
 #include "core/schema.hpp"
 
@@ -23,6 +24,15 @@ struct SetupInfo {
   std::string dt_set_by;     // what sets the stable step
 };
 
+// Non-smooth contact dynamics (solver.scheme = "nscd"): the step of solver.dt = "auto" [s]
+// (docs/nscd.md "The step": the convergence study that chose it) and the default restitution
+// of the contact points, 0: plastic impacts. A rigid block's rocking loses its energy when its
+// pivot changes, and with a plastic impact at the new pivot the theta-method gives Housner's
+// loss of that impact itself; a restitution above 0 would add a bounce that dry masonry joints
+// do not show (docs/nscd.md "Restitution").
+inline constexpr double kNscdDefaultStep = 1e-3;
+inline constexpr double kNscdDefaultRestitution = 0.0;
+
 // Contact penalty of the deck: contact.penalty if given, else penalty_factor x Lamé's first
 // constant of the material.
 double contact_penalty(const Config& config);
@@ -38,6 +48,11 @@ void prescribe_supports(const Config& config, Simulation& sim);
 // Starts the deck's support movement at the simulation's current time, over supports.ramp:
 // the drivers call it once the structure has settled under gravity. Nothing without moves.
 void start_supports(const Config& config, Simulation& sim);
+
+// Non-smooth contact dynamics: a step no longer than the sampling interval of a recorded base
+// signal (the record's own detail is not stepped over). Nothing for the explicit scheme, whose
+// stable step is far shorter, nor for an analytic pulse.
+void fit_step_to_signal(Simulation& sim, const BaseSignal& signal);
 
 // Sets the body load of the context: gravity down, lambda g horizontal.
 void set_static_load(Simulation& sim, double gravity, double lambda);

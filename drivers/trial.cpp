@@ -10,6 +10,7 @@
 
 #include "core/rigid.hpp"
 #include "drivers/setup.hpp"
+#include "drivers/solver_report.hpp"
 
 namespace voussoir {
 
@@ -120,11 +121,11 @@ void add_limit_options(CLI::App* cmd, RunLimits& limits) {
 }
 
 void LoadProgram::apply(Simulation& sim) const {
-  const double t = sim.ctx.time - start;
+  const double t = sim.ctx.time + sim.ctx.load_lead - start;
   const double g = gravity_ramp > 0.0 ? gravity * std::min(1.0, t / gravity_ramp) : gravity;
   const double l = lambda_ramp > 0.0 ? lambda * std::min(1.0, t / lambda_ramp) : lambda;
   double ax = l * gravity;
-  if (signal) ax -= signal->acceleration(sim.ctx.time - signal_start);
+  if (signal) ax -= signal->acceleration(sim.ctx.time + sim.ctx.load_lead - signal_start);
   sim.ctx.body_ax = ax;
   sim.ctx.body_ay = -g;
 }
@@ -239,6 +240,7 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
     return p;
   };
   sync_rigid_nodes(sim.model);
+  const NscdStats solver_start = sim.nscd_stats;
   if (spec.sample_at_start && spec.on_sample && !spec.on_sample(sim, probe_now())) {
     out.steps = 0;
     out.wall_s = seconds_since(wall0);
@@ -293,6 +295,7 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
   }
   sync_rigid_nodes(sim.model);
   sim.ctx.contact_energy = true;
+  note_solver_runs(sim.nscd_stats, solver_start);
   out.time = sim.ctx.time - t_start;
   out.steps = sim.step - step_start;
   out.wall_s = seconds_since(wall0);

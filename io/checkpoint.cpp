@@ -137,6 +137,13 @@ std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
       p.restitution < 1.0)
     for (const double v : {p.normal_stiffness, p.joint_young, p.shear_stiffness, p.restitution})
       f.value(v);
+  // Non-smooth contact dynamics: the scheme and its settings (explicit models hash without).
+  if (c.nscd) {
+    f.text("nscd");
+    const NscdSettings& n = c.nscd_settings;
+    for (const double v : {n.theta, n.tolerance, double(n.max_iterations), n.restitution})
+      f.value(v);
+  }
   return f.h;
 }
 
@@ -164,6 +171,12 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
   for (const auto* v : {&r.ux, &r.uy, &r.theta, &r.vx, &r.vy, &r.omega}) o.array(*v);
   o.value<std::uint8_t>(kContactBytes);
   o.array(sim.contact.save_state());
+  if (c.nscd) {  // the solver's record of the run so far (models of that scheme only)
+    const NscdStats& st = sim.nscd_stats;
+    o.array(std::vector<double>{double(st.steps), double(st.unconverged_steps),
+                                double(st.iterations), double(st.max_iterations),
+                                st.max_residual, st.max_penetration});
+  }
   o.array(driver_state);
   Fnv sum;
   sum.bytes(o.buf.data(), o.buf.size());
@@ -223,6 +236,11 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     for (auto& v : rigid) v = in.array<double>();
   const auto contact_kind = in.value<std::uint8_t>();
   const std::vector<char> contact = in.array<char>();
+  std::vector<double> nscd_stats;
+  if (sim.ctx.nscd) {
+    nscd_stats = in.array<double>();
+    if (nscd_stats.size() != 6) in.fail("the non-smooth contact solver's record is not readable");
+  }
   std::vector<double> driver = in.array<double>();
   if (in.pos + sizeof(std::uint64_t) != buf.size()) in.fail("unexpected data after the state");
   const std::size_t nodes = sim.model.nodes.x.size();
@@ -257,6 +275,12 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     r.vx = rigid[3], r.vy = rigid[4], r.omega = rigid[5];
     for (std::size_t b = 0; b < bodies; ++b)
       r.cx[b] = r.cx0[b] + r.ux[b], r.cy[b] = r.cy0[b] + r.uy[b];
+  }
+  if (sim.ctx.nscd) {
+    NscdStats& st = sim.nscd_stats;
+    st.steps = (long long)nscd_stats[0], st.unconverged_steps = (long long)nscd_stats[1];
+    st.iterations = (long long)nscd_stats[2], st.max_iterations = int(nscd_stats[3]);
+    st.max_residual = nscd_stats[4], st.max_penetration = nscd_stats[5];
   }
   try {
     sim.contact.restore_state(sim.model, contact);

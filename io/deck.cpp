@@ -371,6 +371,10 @@ const std::vector<KeySpec>& key_table() {
       {"solver.dt_safety", [](Reader& r, const toml::node& n, Config& c) { c.solver.dt_safety = r.number(n, {0, true, 1, false}); }},
       {"solver.damping_factor", [](Reader& r, const toml::node& n, Config& c) { c.solver.damping_factor = r.number(n, at_least(0)); }},
       {"solver.end_time", [](Reader& r, const toml::node& n, Config& c) { c.solver.end_time = r.number(n, above(0), "s"); }},
+      {"solver.scheme", [](Reader& r, const toml::node& n, Config& c) { c.solver.scheme = r.choice(n, {"explicit", "nscd"}); }},
+      {"solver.theta", [](Reader& r, const toml::node& n, Config& c) { c.solver.theta = r.number(n, {0.5, true, 1, true}); }},
+      {"solver.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.solver.tolerance = r.number(n, above(0), "relative change of the impulses"); }},
+      {"solver.max_iterations", [](Reader& r, const toml::node& n, Config& c) { c.solver.max_iterations = r.integer(n, 1, 100000000); }},
       // [load]
       {"load.gravity", [](Reader& r, const toml::node& n, Config& c) { c.load.gravity = r.number(n, at_least(0), "m/s2"); }},
       {"load.lambda", [](Reader& r, const toml::node& n, Config& c) { c.load.lambda = r.number(n, any_finite(), "x gravity"); }},
@@ -690,6 +694,12 @@ void check_together(const Reader& r, Config& c) {
                                " = " + value_text(*r.seen.at(pen)) +
                                ": give the joint stiffness (N/m3) or the penalty, not both"));
     }
+  }
+  if (c.solver.scheme == "nscd" && c.material.model != "rigid") {
+    const toml::node* n = r.seen.at("solver.scheme");
+    throw DeckError(one_line(r.where("solver.scheme", n) + "solver.scheme = " + value_text(*n) +
+                             ": non-smooth contact dynamics needs material.model = \"rigid\" "
+                             "(material.model = \"" + c.material.model + "\")"));
   }
   if (given("contact.restitution") && c.contact.restitution < 1.0 && c.material.model != "rigid") {
     const toml::node* n = r.seen.at("contact.restitution");

@@ -82,12 +82,22 @@ const std::map<std::string, std::string>& meanings() {
       {"contact.restitution",
        "impact restitution of rigid blocks (1: no impact damping; below 1 needs "
        "material.model = \"rigid\"; not given: 0.5 for rigid blocks in run, pulse, stability and "
-       "capacity --dynamic, none in the quasi-static capacity trials)"},
+       "capacity --dynamic, none in the quasi-static capacity trials; nscd: 0, plastic impacts)"},
       // [solver]
-      {"solver.dt", "time step: \"auto\" (stable limit x solver.dt_safety) or a value"},
+      {"solver.dt",
+       "time step: \"auto\" (explicit: stable limit x solver.dt_safety; nscd: 1e-3 s, or a "
+       "record's sampling interval if shorter) or a value"},
       {"solver.dt_safety", "fraction of the stable time step that \"auto\" uses"},
       {"solver.damping_factor", "scales the element viscosity eta = 2 h sqrt(E rho)"},
       {"solver.end_time", "simulated time of `run`"},
+      {"solver.scheme",
+       "time scheme: explicit central difference, or nscd: rigid blocks by non-smooth contact "
+       "dynamics, rigid joints (needs material.model = \"rigid\"; docs/nscd.md)"},
+      {"solver.theta", "nscd: Moreau-Jean's theta (0.5: no numerical dissipation)"},
+      {"solver.tolerance",
+       "nscd: the Gauss-Seidel stops when the impulses change by less than this fraction"},
+      {"solver.max_iterations",
+       "nscd: most Gauss-Seidel sweeps a step (a step that reaches it is counted unconverged)"},
       // [load]
       {"load.gravity", "gravity g, downward"},
       {"load.lambda", "horizontal body load factor of `run` (x gravity)"},
@@ -209,6 +219,10 @@ std::string default_of(const std::string& key) {
       {"solver.dt_safety", number(c.solver.dt_safety)},
       {"solver.damping_factor", number(c.solver.damping_factor)},
       {"solver.end_time", number(c.solver.end_time)},
+      {"solver.scheme", quoted(c.solver.scheme)},
+      {"solver.theta", number(c.solver.theta)},
+      {"solver.tolerance", number(c.solver.tolerance)},
+      {"solver.max_iterations", std::to_string(c.solver.max_iterations)},
       {"load.gravity", number(c.load.gravity)},
       {"load.lambda", number(c.load.lambda)},
       {"load.gravity_ramp", number(c.load.gravity_ramp)},

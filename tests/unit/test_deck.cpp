@@ -73,6 +73,10 @@ dt = 2e-7
 dt_safety = 0.4
 damping_factor = 0.5
 end_time = 2.5
+scheme = "explicit"
+theta = 0.75
+tolerance = 1e-5
+max_iterations = 300
 
 [load]
 gravity = 9.8
@@ -189,6 +193,10 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.solver.dt_safety, 0.4);
   EXPECT_DOUBLE_EQ(c.solver.damping_factor, 0.5);
   EXPECT_DOUBLE_EQ(c.solver.end_time, 2.5);
+  EXPECT_EQ(c.solver.scheme, "explicit");
+  EXPECT_DOUBLE_EQ(c.solver.theta, 0.75);
+  EXPECT_DOUBLE_EQ(c.solver.tolerance, 1e-5);
+  EXPECT_EQ(c.solver.max_iterations, 300);
   EXPECT_DOUBLE_EQ(c.load.gravity, 9.8);
   EXPECT_DOUBLE_EQ(c.load.lambda, 0.3);
   EXPECT_DOUBLE_EQ(c.load.gravity_ramp, 0.2);
