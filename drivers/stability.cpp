@@ -72,8 +72,9 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   // that much later, and the collapse limits widen by what the movement imposes.
   double moved_by = 0.0;  // [s] the support movement's share of the cell's time
   MotionExtent allowed;
+  const double ramp = load_ramp(tc, sim);  // none under nscd (drivers/capacity.hpp)
   if (!sim.supports.empty()) {
-    start_support_motion(sim.supports, tc.ramp_time, config.supports.ramp);
+    start_support_motion(sim.supports, ramp, config.supports.ramp);
     moved_by = config.supports.ramp;
     allowed = support_allowance(sim.supports, c.l_ref);
   }
@@ -82,16 +83,16 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   spec.label = "the stability cell " + cell_label;
   spec.loads = LoadProgram{};
   spec.loads->gravity = g;
-  spec.loads->gravity_ramp = tc.ramp_time;
+  spec.loads->gravity_ramp = ramp;
   spec.limits = tc.limits;
   spec.track_motion = true;
   spec.min_time = ke_time;
   spec.rules.push_back(std::make_unique<CollapseRule>(d_collapse + allowed.displacement,
                                                       tc.collapse_rotation + allowed.rotation));
-  spec.rules.push_back(std::make_unique<RestRule>(v_rest, tc.hold_time, tc.ramp_time + moved_by));
+  spec.rules.push_back(std::make_unique<RestRule>(v_rest, tc.hold_time, ramp + moved_by));
   spec.rules.push_back(std::make_unique<TrendRule>(
-      d_collapse, tc.collapse_rotation, moved_by > 0.0 ? tc.ramp_time + moved_by : 0.0,
-      tc.ramp_time + moved_by, tc.max_time + moved_by));
+      d_collapse, tc.collapse_rotation, moved_by > 0.0 ? ramp + moved_by : 0.0,
+      ramp + moved_by, tc.max_time + moved_by));
   bool ke_read = false;
   spec.on_sample = [&](const Simulation& s, const Probe& p) {
     if (!ke_read && p.time >= ke_time) {
