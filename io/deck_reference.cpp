@@ -89,7 +89,8 @@ const std::map<std::string, std::string>& meanings() {
       {"solver.damping_factor", "scales the element viscosity eta = 2 h sqrt(E rho)"},
       {"solver.end_time", "simulated time of `run`"},
       // [load]
-      {"load.gravity", "gravity g, downward"},
+      {"load.gravity",
+       "gravity g, downward (0: a weightless deck, which only `check` and `run` take)"},
       {"load.lambda", "horizontal body load factor of `run` (x gravity)"},
       {"load.gravity_ramp",
        "`run`: gravity and lambda g brought on together, linearly, over this time (0: from "
