@@ -177,7 +177,8 @@ int main(int argc, char** argv) {
   pushover->add_option("--direction", push_opts.direction, "direction of the load: +x or -x")
       ->capture_default_str();
   pushover->add_option("--rate", push_opts.rate,
-                       "speed of the control target [m/s] (default 0.03 sqrt(g L_ref))");
+                       "speed of the control target [m/s] (default " +
+                           voussoir::option_number(voussoir::kRateFactor) + " sqrt(g L_ref))");
   pushover->add_option("--max-displacement", push_opts.max_displacement,
                        "largest control displacement [m] (default half the structure's height)");
   pushover->add_option("--servo", push_opts.servo,
@@ -431,6 +432,8 @@ int main(int argc, char** argv) {
     const voussoir::Config config = voussoir::load_deck(deck.deck, deck.sets);
     if (check->parsed()) return voussoir::command_check(config, common, check_opts);
     if (run->parsed()) return voussoir::command_run(config, common, run_opts);
+    for (const CLI::App* cmd : {capacity, pushover, spread, ida, pulse})
+      if (cmd->parsed()) voussoir::require_gravity(config, cmd->get_name());
     if (capacity->parsed()) return voussoir::command_capacity(config, common, cap_opts);
     if (limit->parsed()) return voussoir::command_limit(config, common, limit_opts);
     if (pushover->parsed()) return voussoir::command_pushover(config, common, push_opts);
@@ -438,10 +441,12 @@ int main(int argc, char** argv) {
     if (ida->parsed()) {
       ida_opts.period_given = ida->count("--period") > 0;
       ida_opts.start_given = ida->count("--start") > 0;
+      ida_opts.lambda_star_given = ida->count("--lambda-star") > 0;
       return voussoir::command_ida(config, common, ida_opts);
     }
     if (pulse->parsed()) {
       pulse_opts.start_given = pulse->count("--start") > 0;
+      pulse_opts.lambda_star_given = pulse->count("--lambda-star") > 0;
       pulse_opts.tilt_reference_given = pulse->count("--tilt-reference") > 0;
       return voussoir::command_pulse(config, common, pulse_opts);
     }

@@ -28,6 +28,29 @@ double restitution_damping_ratio(double e) {
   return -l / std::sqrt(std::numbers::pi * std::numbers::pi + l * l);
 }
 
+double no_tension_restitution(double zeta) {
+  if (!(zeta > 0.0)) return 1.0;
+  if (!(zeta < 1.0)) return std::exp(-2.0);  // critical: the force vanishes at w t = 2
+  // x = (v0 / wd) exp(-zeta w t) sin(wd t): the force w^2 x + 2 zeta w x' vanishes at
+  // phi = wd t_e with tan(phi) = -2 zeta s / (1 - 2 zeta^2), s = sqrt(1 - zeta^2), phi in
+  // (0, pi); e = -x'(t_e) / v0.
+  const double s = std::sqrt(1.0 - zeta * zeta);
+  const double phi = std::numbers::pi - std::atan2(2.0 * zeta * s, 1.0 - 2.0 * zeta * zeta);
+  return -std::exp(-zeta * phi / s) * (std::cos(phi) - zeta / s * std::sin(phi));
+}
+
+double no_tension_damping_ratio(double e) {
+  if (!(e < 1.0)) return 0.0;
+  if (!(e > std::exp(-2.0))) return 1.0;
+  // no_tension_restitution falls from 1 at zeta = 0 to exp(-2) at 1: bisection.
+  double lo = 0.0, hi = 1.0;
+  for (int k = 0; k < 200 && hi - lo > 1e-15; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (no_tension_restitution(mid) > e ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 namespace {
 
 // The boundary edges of triangle e in the reference configuration.

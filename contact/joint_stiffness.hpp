@@ -115,6 +115,20 @@ double extent_along(const std::vector<Vec2>& polygon, const Vec2& direction);
 // Damping ratio of the restitution e in [0, 1] (above); 0 at e = 1.
 double restitution_damping_ratio(double e);
 
+// The rigid joints' dashpot pulls no block (no tension, contact/rigid_contact.hpp): a normal
+// impact on a spring kn and a dashpot 2 zeta omega limited to compression ends when their
+// force vanishes, before the overlap does, and rebounds with
+//     e(zeta) = -exp(-zeta phi / s) (cos phi - zeta / s sin phi),  s = sqrt(1 - zeta^2),
+//     phi = pi - atan2(2 zeta s, 1 - 2 zeta^2)                       (zeta < 1),
+// exp(-2) = 0.135 at zeta = 1 (Schwager and Poeschel, Granular Matter 9, 2007, 465: the linear
+// dashpot with the no-tension condition); more than exp(-pi zeta / s), the restitution of the
+// dashpot that may pull (restitution_damping_ratio), at every zeta > 0.
+double no_tension_restitution(double zeta);
+
+// Its inverse: the damping ratio that gives the restitution e, 1 (the critical dashpot, whose
+// restitution exp(-2) = 0.135 is the least) for any e <= exp(-2), 0 for e >= 1.
+double no_tension_damping_ratio(double e);
+
 // kn = kRigidJointFactor x E / L of a joint of unit normal `normal` between block a and block b
 // (b == nullptr or without outline: a fixed support; L from a alone) [N/m3] (above).
 double default_joint_stiffness(double young, const Block& a, const Block* b, const Vec2& normal);

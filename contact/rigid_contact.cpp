@@ -351,7 +351,7 @@ void RigidContact::setup(const Model& model, const ContactParams& params, double
   mu_ = params.friction;
   thickness_ = model.out_of_plane;
   damping_ = params.restitution < 1.0;
-  zeta_ = restitution_damping_ratio(params.restitution);
+  zeta_ = no_tension_damping_ratio(params.restitution);
   kn_given_ = params.normal_stiffness;
   ks_given_ = params.shear_stiffness;
   young_ = params.joint_young;
@@ -801,6 +801,10 @@ void RigidContact::pose_bodies(const Model& model) {
       // |O| / L took to reach at the approach rate: the dashpot acts for that part only.
       double part = 1.0;
       if (!touched && rate_m * dt * len > o.area) part = o.area / (rate_m * dt * len);
+      // No tension: a separating joint's dashpot pulls no harder than its spring pushes
+      // (rigid_contact.hpp), both of its terms scaled alike.
+      const double spring = kn_t * o.area, pull = part * c_damp * len * rate_m;
+      if (pull < -spring) part *= spring / -pull;
       const Vec2 fd = (part * c_damp * len * rate_m) * n;
       const double twist = part * c_damp * len * len * len / 12.0 * rate_s;
       damp = damp + fd;

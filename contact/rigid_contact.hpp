@@ -77,7 +77,11 @@
 // rate of the pair's force and moments, by the backward difference. A pair turning with the
 // structure turns its force, and that dashpot then pushed along the turn: on the shaking-table
 // arch it fed a slow sway that never came to rest. Taking the rate of the force's magnitude
-// instead did not end it.)
+// instead did not end it.) No tension: on a separating overlap (d'_m < 0) the dashpot's normal
+// force beta kn t_z L d'_m would pull; when it pulls harder than the spring pushes
+// (kn t_z |O|), both dashpot terms are scaled by kn |O| / (beta kn L |d'_m|), so that the
+// overlap's total normal force is zero, never tensile, and the dissipation, scaled by the same
+// factor, stays >= 0.
 //
 // Ledger: the dashpots' and friction's generalized forces on each body are booked by the
 // trapezoid over the body's position increment (dt v^(n-1/2), dt omega^(n-1/2)), as the

@@ -12,14 +12,21 @@
 
 namespace voussoir {
 
+double log_normal_survival(double z) {
+  // erfc(z / sqrt 2) underflows past z ~ 38 (1 - Phi(38) ~ 3e-316); from kTail on, Mills'
+  // ratio: 1 - Phi(z) = phi(z) R(z), R(z) = (1/z)(1 - 1/z^2 + 3/z^4 - 15/z^6 + 105/z^8 - ...),
+  // the next term 945/z^10 < 2e-12 of the sum there (Abramowitz & Stegun 26.2.12).
+  constexpr double kTail = 30.0;
+  if (z < kTail) return std::log(0.5 * std::erfc(z / std::sqrt(2.0)));
+  const double w = 1.0 / (z * z);
+  const double series = 1.0 + w * (-1.0 + w * (3.0 + w * (-15.0 + w * 105.0)));
+  return -0.5 * z * z - std::log(z * std::sqrt(2.0 * M_PI)) + std::log(series);
+}
+
 namespace {
 
 constexpr int kBrentBits = std::numeric_limits<double>::digits;
-
-// ln(1 - Phi(z)), accurate far in the upper tail.
-double log_survival(double z) {
-  return std::log(0.5 * std::erfc(z / std::sqrt(2.0)));
-}
+constexpr char kCollapsed = 0, kAbove = 1, kBelow = 2;  // a record's sample kind
 
 // ln L(mu, beta) of the header comment (without its constant).
 double log_likelihood(const std::vector<double>& y, const std::vector<char>& censored, double mu,
@@ -27,7 +34,11 @@ double log_likelihood(const std::vector<double>& y, const std::vector<char>& cen
   double sum = 0.0;
   for (std::size_t i = 0; i < y.size(); ++i) {
     const double z = (y[i] - mu) / beta;
-    sum += censored[i] ? log_survival(z) : -std::log(beta) - 0.5 * z * z;
+    // Censored above x_i: ln(1 - Phi(z)); below it (a collapse at every intensity tried, the
+    // smallest x_i): ln Phi(z) = ln(1 - Phi(-z)).
+    sum += censored[i] == kAbove   ? log_normal_survival(z)
+           : censored[i] == kBelow ? log_normal_survival(-z)
+                                   : -std::log(beta) - 0.5 * z * z;
   }
   return sum;
 }
@@ -43,9 +54,11 @@ LognormalFit fit_lognormal(const std::vector<IntensitySample>& samples) {
   for (const IntensitySample& s : samples) {
     if (!(s.im > 0.0) || !std::isfinite(s.im))
       throw std::invalid_argument("fragility: an intensity must be a positive number of g");
+    if (s.censored && s.below)
+      throw std::invalid_argument("fragility: a record is censored above or below, not both");
     y.push_back(std::log(s.im));
-    censored.push_back(s.censored ? 1 : 0);
-    if (s.censored)
+    censored.push_back(s.censored ? kAbove : s.below ? kBelow : kCollapsed);
+    if (s.censored || s.below)
       ++fit.censored;
     else
       collapsed.push_back(y.back());
@@ -101,19 +114,34 @@ MedianInterval bootstrap_median(const std::vector<IntensitySample>& samples, int
       s = samples[std::min(n - 1, static_cast<std::size_t>(u * static_cast<double>(n)))];
     }
     const LognormalFit fit = fit_lognormal(set);
-    if (fit.ok)
+    if (fit.ok) {
       medians.push_back(fit.median);
-    else
-      ++out.without_fit;
+      continue;
+    }
+    // Without a fit, the resample's median at its limit (header comment).
+    ++out.without_fit;
+    double sum = 0.0;
+    int collapsed = 0;
+    bool above = false;
+    for (const IntensitySample& s : set) {
+      if (!s.censored && !s.below) sum += std::log(s.im), ++collapsed;
+      above = above || s.censored;
+    }
+    medians.push_back(collapsed > 0 ? std::exp(sum / collapsed)
+                      : above       ? std::numeric_limits<double>::infinity()
+                                    : 0.0);
   }
   out.resamples = static_cast<int>(medians.size());
-  if (medians.empty()) return out;
   std::sort(medians.begin(), medians.end());
   auto quantile = [&](double p) {
     const double h = p * static_cast<double>(medians.size() - 1);
     const std::size_t k = static_cast<std::size_t>(std::floor(h));
     if (k + 1 >= medians.size()) return medians.back();
-    return medians[k] + (h - static_cast<double>(k)) * (medians[k + 1] - medians[k]);
+    const double f = h - static_cast<double>(k);
+    if (f == 0.0) return medians[k];
+    // Between a median and an infinite one the quantile is unbounded (inf x 0 is no number).
+    if (std::isinf(medians[k + 1])) return medians[k + 1];
+    return medians[k] + f * (medians[k + 1] - medians[k]);
   };
   out.lo = quantile(0.5 * (1.0 - confidence));
   out.hi = quantile(0.5 * (1.0 + confidence));

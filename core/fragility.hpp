@@ -14,7 +14,10 @@
 //     ln L(mu, beta) = sum over collapsed records [ -ln beta - z_i^2 / 2 ]
 //                    + sum over censored records  ln( 1 - Phi(z_i) ).
 // A censored record is one that did not collapse up to the largest intensity it was run at,
-// x_i (the search's cap): all that is known is that its collapse intensity exceeds x_i.
+// x_i (the search's cap): all that is known is that its collapse intensity exceeds x_i. A
+// record censored below collapsed at every intensity tried, down to the smallest, x_i
+// (drivers/pulse.hpp kMinAmplitude): its collapse intensity is at most x_i, and its term is
+// ln Phi(z_i) = ln(1 - Phi(-z_i)).
 //   - Without censored records the maximum is in closed form: mu = mean of y_i and
 //     beta^2 = mean of (y_i - mu)^2 (the 1/n variance: the maximum-likelihood estimate; Baker's
 //     method-of-moments estimate divides by n - 1 and is larger by sqrt(n / (n - 1)), 8% for 7
@@ -30,10 +33,16 @@
 // Introduction to the Bootstrap", 1993, ch. 13): `resamples` sets of n records drawn with
 // replacement from the n records, each fitted as above; the interval is the (1 - c)/2 and
 // (1 + c)/2 empirical quantiles (linear interpolation between order statistics) of the resampled
-// medians. Resamples without a fit (fewer than two distinct collapse intensities) are left out
-// and counted. The draws come from std::mt19937_64 seeded by `seed`, turned into indices by hand
-// (the standard distributions differ between standard libraries), so an interval is the same on
-// every machine, thread count and MPI rank count.
+// medians. Every resample counts (leaving out those without a fit would bias the interval
+// towards the resamples that happen to hold two distinct collapses: 11% of them are left out
+// with 3 records): one without a fit (fewer than two distinct collapse intensities) enters at
+// its median's limit -- the geometric mean of its collapse intensities (one value v: the fit's
+// limit as beta -> 0 without censored records), +infinity when none of its records collapsed
+// and one is censored above (its median lies above every intensity run), 0 when all collapse
+// at every intensity tried. An end of the interval may therefore be +infinity (written null in
+// JSON): the records do not bound the median from above. The draws come from std::mt19937_64 seeded
+// by `seed`, turned into indices by hand (the standard distributions differ between standard
+// libraries), so an interval is the same on every machine, thread count and MPI rank count.
 
 #include <cstdint>
 #include <string>
@@ -43,8 +52,9 @@ namespace voussoir {
 
 // One record's result: its collapse intensity, or (censored) the largest intensity it survived.
 struct IntensitySample {
-  double im = 0.0;  // [g], > 0
-  bool censored = false;
+  double im = 0.0;        // [g], > 0
+  bool censored = false;  // no collapse up to im: the collapse intensity lies above
+  bool below = false;     // a collapse at every intensity tried, im the smallest: it lies below
 };
 
 struct LognormalFit {
@@ -53,7 +63,7 @@ struct LognormalFit {
   double median = 0.0;  // theta [g]
   double beta = 0.0;    // logarithmic standard deviation
   int samples = 0;      // records fitted
-  int censored = 0;     // of which censored
+  int censored = 0;     // of which censored (above or below)
 };
 
 // Maximum-likelihood lognormal fit (header comment). Throws std::invalid_argument for an
@@ -61,16 +71,20 @@ struct LognormalFit {
 LognormalFit fit_lognormal(const std::vector<IntensitySample>& samples);
 
 struct MedianInterval {
-  double lo = 0.0, hi = 0.0;  // [g]
+  double lo = 0.0, hi = 0.0;  // [g]; hi (or both) +infinity when the records leave it unbounded
   double confidence = 0.0;    // c
-  int resamples = 0;          // fitted resamples used
-  int without_fit = 0;        // resamples left out (no fit)
+  int resamples = 0;          // resamples drawn (0: none, no interval)
+  int without_fit = 0;        // of which without a fit, entered at their limit
 };
 
 // Percentile-bootstrap interval of the median (header comment); `confidence` in (0, 1),
-// `resamples` >= 1. An interval with lo = hi = 0 when no resample had a fit.
+// `resamples` >= 1. No interval (resamples = 0) without samples.
 MedianInterval bootstrap_median(const std::vector<IntensitySample>& samples, int resamples,
                                 std::uint64_t seed, double confidence = 0.95);
+
+// ln(1 - Phi(z)) of the standard normal, finite for every finite z (erfc underflows past
+// z ~ 38; Mills' ratio from z = 30 on).
+double log_normal_survival(double z);
 
 // P(collapse | im) of a fit: Phi(ln(im / median) / beta).
 double collapse_probability(const LognormalFit& fit, double im);

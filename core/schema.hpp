@@ -160,6 +160,7 @@ struct SupportMoveConfig {
   double dx = 0.0;        // displacement of the block [m]
   double dy = 0.0;        // [m]
   double rotation = 0.0;  // counter-clockwise about the block's centroid [deg]
+  std::string where;      // where the deck gives `block` ("deck.toml:7:11: "; "" when unknown)
 };
 
 struct SupportsConfig {

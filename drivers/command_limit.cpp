@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "drivers/capacity.hpp"
+#include "drivers/commands.hpp"
 #include "drivers/limit_command.hpp"
 #include "io/deck.hpp"
 #include "io/json.hpp"
@@ -94,6 +95,11 @@ nlohmann::json interfaces_json(const LimitResult& res) {
 int command_limit(const Config& config, const CommonOptions& common,
                   const LimitCommandOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
+  require_gravity(config, "limit");
+  if (opts.gravity_only && !opts.thrust.empty())
+    throw DeckError("limit --thrust " + opts.thrust +
+                    " with --gravity-only: give one of them (--thrust bounds the thrust under "
+                    "gravity alone already)");
   // [supports]: the blocks where the support movement leaves them (settled under gravity and
   // moved as `capacity` does it, then carried rigidly: drivers/capacity.hpp moved_blocks).
   MovedBlocks moved;
@@ -112,12 +118,6 @@ int command_limit(const Config& config, const CommonOptions& common,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double mu = config.contact.friction;
   const double g = config.load.gravity;
-  if (!(g > 0.0)) {
-    char value[64];
-    std::snprintf(value, sizeof value, "%g", g);
-    throw DeckError(config.deck_path + ": load.gravity = " + value +
-                    ": limit analysis needs gravity > 0 (the load is lambda x weight)");
-  }
   if (!common.quiet)
     std::fprintf(stderr, "limit: %zu blocks, model built in %.2f s; solving the LP...\n",
                  model.blocks.size(), model_s);

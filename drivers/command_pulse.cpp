@@ -343,7 +343,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
   for (const CurvePoint& p : points) {
     std::printf("%10.3f %12.5f %8.3f   [%8.5f, %8.5f] %7d %9.1f %10.2e%s\n", p.frequency,
                 p.amplitude, p.amplitude / quasi_static, p.lo, p.hi, p.trials, p.wall_s,
-                p.max_energy_balance_error, p.bracketed ? "" : "  (no collapse up to the cap)");
+                p.max_energy_balance_error, point_note(p).c_str());
     if (!p.stable_above.empty())
       std::printf("%10s survived above A_c (non-monotone) at %s g\n", "",
                   list_of(p.stable_above, ", ").c_str());
@@ -377,6 +377,7 @@ int curve_run(const Config& config, const CommonOptions& common, const PulseOpti
                           {"amplitude", p.amplitude},
                           {"bracket", {p.lo, p.hi}},
                           {"bracketed", p.bracketed},
+                          {"collapses_everywhere", p.collapses_everywhere},
                           {"trials", p.trials},
                           {"wall_s", p.wall_s},
                           {"max_energy_balance_error", p.max_energy_balance_error},

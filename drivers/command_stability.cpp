@@ -32,6 +32,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   std::vector<GridAxis> axes;
   for (const std::string& p : opts.params) axes.push_back(parse_grid_param(p));
   const Grid grid = make_grid(deck_path, sets, axes);
+  for (const Config& c : grid.configs) require_gravity(c, "stability");
   StabilityCriteria crit;
   crit.ke_time = opts.ke_time;
   crit.trial.limits = common.limits;

@@ -41,6 +41,7 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   for (const std::string& p : opts.params) axes.push_back(parse_grid_param(p));
   // Every cell's deck validated up front, so a bad value stops the sweep before any work.
   const Grid grid = make_grid(deck_path, sets, axes);
+  for (const Config& c : grid.configs) require_gravity(c, "sweep");
   const size_t cells = grid.configs.size();
   const std::vector<std::vector<std::string>>& cell_values = grid.values;
   const std::vector<Config>& configs = grid.configs;

@@ -262,9 +262,22 @@ int command_synth(const SynthOptions& o) {
         {"ec8_mean_spectrum_ok", spectrum_ok},
         {"ec8_mean_pga_ok", pga_ok},
         {"files", files},
-        {"wall_seconds", wall}};
+        {"wall_s", wall}};
     write_json(j, o.json);
   }
+  // The rule's outcome is the exit status (docs/records.md "Artificial records"): a set that
+  // fails it is written for inspection, and a script (synth, then ida on its records) stops.
+  if (!spectrum_ok || !pga_ok)
+    throw RunError(std::string("the set fails EN 1998-1 3.2.3.1.2 (4): ") +
+                   (!spectrum_ok ? "its mean spectrum falls to " + num(mean.least) +
+                                       " x the target at T = " + num(mean.least_period) +
+                                       " s (at least 0.9 needed)"
+                                 : "") +
+                   (!spectrum_ok && !pga_ok ? "; " : "") +
+                   (!pga_ok ? "its mean PGA " + num(set.mean_pga) +
+                                  " g is below ag S = " + num(pga_floor) + " g"
+                            : "") +
+                   "; the records are written in " + o.output + " for inspection");
   return 0;
 }
 

@@ -64,6 +64,18 @@ std::string failure_mode_text(const CapacityResult& result);
 // The joint indices of the hinges of one kind ("hinge" or "sliding"), space separated.
 std::string joint_list(const std::vector<Hinge>& hinges, const std::string& kind);
 
+// The analyses whose loads are multiples of the blocks' weight (lambda g, a base amplitude in g,
+// the friction that the weight presses into the joints) refuse load.gravity = 0 by name
+// (exit 2): `command` would find nothing to measure. `check` and `run` accept it (a weightless
+// run: a base record in m/s2 still drives it).
+inline void require_gravity(const Config& config, const std::string& command) {
+  if (!(config.load.gravity > 0.0))
+    throw DeckError(config.deck_path + ": load.gravity = " + option_number(config.load.gravity) +
+                    ": `" + command +
+                    "` needs gravity > 0 (its loads are multiples of the blocks' weight; only "
+                    "`check` and `run` take a weightless deck)");
+}
+
 int command_check(const Config& config, const CommonOptions& common, const CheckOptions& opts);
 
 struct RunOptions {

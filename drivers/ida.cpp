@@ -73,6 +73,16 @@ std::string list_of(const std::vector<double>& v, const char* sep) {
   return out;
 }
 
+// [lo, hi] of the median's interval; an unbounded end (+infinity) is null, and so is the
+// interval when no resample was drawn.
+nlohmann::json median_ci_json(const MedianInterval& ci) {
+  if (ci.resamples == 0) return nullptr;
+  auto end = [](double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
+  return {end(ci.lo), end(ci.hi)};
+}
+
 std::vector<double> scaled(const std::vector<double>& v, double by) {
   std::vector<double> out;
   for (double x : v) out.push_back(x * by);
@@ -89,6 +99,7 @@ std::string ida_runs_csv(const std::string& csv) {
 void validate_ida_options(const IdaOptions& opts) {
   if (opts.records.empty())
     throw DeckError("ida needs --records F1,F2,... (PEER .AT2 or two-column files)");
+  check_lambda_star_option("ida", opts.lambda_star_given, opts.lambda_star);
   if (opts.im != "pga" && opts.im != "sa")
     throw DeckError("ida --im \"" + opts.im +
                     "\" is not allowed: use \"pga\" (peak ground acceleration) or \"sa\" "
@@ -191,7 +202,8 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
   for (std::size_t i = 0; i < records.size(); ++i) {
     const SearchOutcome& out = outcomes[i];
     if (!out.error.empty()) continue;
-    samples.push_back({out.point.amplitude * records[i].ratio, !out.point.bracketed});
+    samples.push_back({out.point.amplitude * records[i].ratio, !out.point.bracketed,
+                       out.point.collapses_everywhere});
   }
   const LognormalFit fit = fit_lognormal(samples);
   const MedianInterval ci =
@@ -250,7 +262,7 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
     const double r = records[i].ratio;
     std::printf("%-28s %9.4f %10.4f   [%8.4f, %8.4f] %7d %9.1f%s%s\n", cells[i].key.label.c_str(),
                 records[i].pga, p.amplitude * r, p.lo * r, p.hi * r, p.trials, p.wall_s,
-                p.bracketed ? "" : "  (no collapse up to the cap: censored)",
+                point_note(p, r).c_str(),
                 outcomes[i].error.empty() ? "" : ("  error: " + outcomes[i].error).c_str());
     if (!p.stable_above.empty())
       std::printf("%28s survived above IM_c at %s g\n", "",
@@ -295,6 +307,7 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
                           {"collapse_im", p.amplitude * r},
                           {"bracket", {p.lo * r, p.hi * r}},
                           {"bracketed", p.bracketed},
+                          {"collapses_everywhere", p.collapses_everywhere},
                           {"trials", p.trials},
                           {"wall_s", p.wall_s},
                           {"max_energy_balance_error", p.max_energy_balance_error},
@@ -305,9 +318,12 @@ int command_ida(const Config& config, const CommonOptions& common, const IdaOpti
     }
     nlohmann::json fragility = nullptr;
     if (fit.ok)
-      fragility = {{"median", fit.median},        {"beta", fit.beta},
-                   {"median_ci", {ci.lo, ci.hi}}, {"confidence", opts.confidence},
-                   {"bootstrap", ci.resamples},   {"records", fit.samples},
+      fragility = {{"median", fit.median},
+                   {"beta", fit.beta},
+                   {"median_ci", median_ci_json(ci)},
+                   {"confidence", opts.confidence},
+                   {"bootstrap", ci.resamples},
+                   {"records", fit.samples},
                    {"censored", fit.censored}};
     nlohmann::json j = {{"im", opts.im},
                         {"period", opts.im == "sa" ? opts.period : 0.0},

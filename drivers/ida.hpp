@@ -43,6 +43,7 @@ struct IdaOptions {
   double period = 0.0;               // --period T [s] (for sa)
   bool period_given = false;
   double lambda_star = -1.0;  // --lambda-star X: skip the capacity search (< 0: compute)
+  bool lambda_star_given = false;
   int points = 2;             // --points: capacity trials per round
   double start = 0.0;         // --start X [g of IM] (not given: lambda* in PGA)
   bool start_given = false;

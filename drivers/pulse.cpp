@@ -323,8 +323,9 @@ void to_json(nlohmann::json& j, const PulseResult& r) {
 void from_json(const nlohmann::json& j, PulseResult& r) {
   r = pulse_run_from_record(j);
 }
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(CurvePoint, frequency, amplitude, lo, hi, bracketed, trials,
-                                   wall_s, max_energy_balance_error, stable_above, runs)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(CurvePoint, frequency, amplitude, lo, hi, bracketed,
+                                   collapses_everywhere, trials, wall_s, max_energy_balance_error,
+                                   stable_above, runs)
 
 nlohmann::json curve_point_record(const CurvePoint& point) {
   return point;
@@ -397,7 +398,7 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
   double a = search.start;
   if (trial(a)) {
     hi = a, have_hi = true;
-    while (!have_lo && a > 1e-3) {
+    while (!have_lo && a > kMinAmplitude) {
       a /= growth;
       if (trial(a)) {
         hi = a;
@@ -417,8 +418,12 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     }
   }
   cp.bracketed = have_hi;
+  // Every amplitude run collapsed, down to the smallest tried: no survival to bisect from (a
+  // bracket [0, hi] would take runs until hi underflows). The point says so, with A_c = hi the
+  // smallest amplitude run (an upper bound of the collapse amplitude).
+  cp.collapses_everywhere = have_hi && !have_lo;
   const double first_collapse = hi;
-  if (have_hi) {  // bisection (drivers/bracket.hpp)
+  if (have_hi && have_lo) {  // bisection (drivers/bracket.hpp)
     Bracket b{lo, hi};
     shrink_bracket(
         b, search.tolerance, 1, ProbePlacement::Midpoint,
@@ -430,7 +435,7 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     hi = b.hi;
   }
   // Stepping: the steps above the first collapse (non-monotone check; A_c stays hi).
-  if (stepping && have_hi) {
+  if (stepping && have_hi && have_lo) {
     double above = first_collapse;
     for (int k = 0; k < search.steps_above && above * growth <= kMaxAmplitude; ++k) {
       above *= growth;
@@ -444,6 +449,13 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
   cp.trials = static_cast<int>(cp.runs.size());
   cp.wall_s = seconds_since(wall0);
   return cp;
+}
+
+std::string point_note(const CurvePoint& point, double scale) {
+  if (point.collapses_everywhere)
+    return std::string("  (") + kCollapsesEverywhere + ", down to " +
+           option_number(point.amplitude * scale) + " g: an upper bound)";
+  return point.bracketed ? "" : "  (no collapse up to the cap: censored)";
 }
 
 std::optional<TiltingCapacity> study_capacity(const Config& config, const TrialCriteria& settle,
@@ -538,7 +550,15 @@ std::vector<SearchOutcome> deal_searches(
   return outcomes;
 }
 
+void check_lambda_star_option(const std::string& command, bool given, double lambda_star) {
+  if (given && !(lambda_star > 0.0 && std::isfinite(lambda_star)))
+    throw DeckError(command + " --lambda-star " + option_number(lambda_star) +
+                    " is not allowed: the tilting capacity must be a positive number (leave the "
+                    "option out to compute it)");
+}
+
 void validate_pulse_options(const PulseOptions& opts) {
+  check_lambda_star_option("pulse", opts.lambda_star_given, opts.lambda_star);
   if (!(opts.free_time > 0.0 && std::isfinite(opts.free_time)))
     throw DeckError("pulse --free-time " + option_number(opts.free_time) +
                     " s is not allowed: the free motion after the signal must be a positive time");

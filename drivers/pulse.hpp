@@ -43,7 +43,9 @@
 //           lambda* / peak factor: a pulse that peaks below lambda* g cannot tip a structure
 //           whose tilting capacity is lambda*, up to dynamic effects), A_{k+1} = A_k (1 + step)
 //           (step 0.05: each step 5% above the last) until the first collapse A_k (at most
-//           kMaxAmplitude g; if A_0 already collapses, down by the same factor until a survival),
+//           kMaxAmplitude g; if A_0 already collapses, down by the same factor until a survival
+//           or kMinAmplitude g: collapsing all the way down, the point says it collapses at
+//           every amplitude tried, A_c the smallest, and nothing is bisected),
 //           then bisection inside [A_{k-1}, A_k] until hi - lo <= tolerance x hi. Then
 //           `steps_above` further steps above A_k, A_k (1 + step)^j, look for amplitudes that
 //           survive above a collapsing one (reported, never used to move A_c).
@@ -158,6 +160,9 @@ struct CurvePoint {
   double amplitude = 0.0;     // [g] smallest collapsing amplitude found (hi)
   double lo = 0.0, hi = 0.0;  // bracket [g]: survived at lo, collapsed at hi
   bool bracketed = false;     // false: no collapse up to kMaxAmplitude
+  // Every amplitude run collapsed, down to the smallest the search tries (kMinAmplitude):
+  // lo = 0, hi = amplitude = that smallest amplitude, an upper bound (no bisection).
+  bool collapses_everywhere = false;
   int trials = 0;
   double wall_s = 0.0;
   double max_energy_balance_error = 0.0;  // over the trials
@@ -168,6 +173,11 @@ struct CurvePoint {
 
 constexpr double kBracketGrowth = 1.5;
 constexpr double kMaxAmplitude = 20.0;  // [g]
+// The search steps down from a collapsing start no further than this [g]: a structure that
+// collapses at every amplitude down to it collapses at every amplitude tried.
+constexpr double kMinAmplitude = 1e-3;
+// How a point's outcome reads when every amplitude tried collapsed (text, CSV and JSON).
+inline constexpr const char* kCollapsesEverywhere = "collapses at every amplitude tried";
 
 enum class AmplitudeSearch { Step, Bisect };
 
@@ -256,6 +266,11 @@ PulseResult pulse_run_from_record(const nlohmann::json& record);
 nlohmann::json curve_point_record(const CurvePoint& point);
 CurvePoint curve_point_from_record(const nlohmann::json& record);
 
+// A point's outcome as the tables print it after its numbers: "" for a bisected collapse,
+// "  (no collapse up to the cap: censored)" or "  (collapses at every amplitude tried, down to
+// A g: an upper bound)", A the point's amplitude x `scale` (an IDA's IM per PGA).
+std::string point_note(const CurvePoint& point, double scale = 1.0);
+
 // The amplitudes of `runs` that survived above the smallest collapsing one, ascending.
 std::vector<double> stable_above_collapse(const std::vector<PulseResult>& runs);
 
@@ -268,6 +283,7 @@ struct PulseOptions {
   std::string csv;              // --csv FILE (curve; default curve.csv)
   std::string plot;             // --plot FILE.png (curve, by scripts/plot_curve)
   double lambda_star = -1.0;    // --lambda-star X: skip the capacity search (< 0: compute)
+  bool lambda_star_given = false;
   double tolerance = 0.02;      // --tolerance: relative bracket width on A
   int points = 2;               // --points: capacity trials per round
   std::string search = "step";  // --search step|bisect (AmplitudeSearch)
@@ -287,6 +303,10 @@ struct PulseOptions {
 // Checks the options (the curve's search and frequencies with --curve): DeckError (exit 2)
 // naming the option, the value and what is allowed.
 void validate_pulse_options(const PulseOptions& opts);
+
+// --lambda-star of `command` (pulse, ida), when given: a positive finite tilting capacity, else
+// DeckError naming the option and value.
+void check_lambda_star_option(const std::string& command, bool given, double lambda_star);
 
 int command_pulse(const Config& config, const CommonOptions& common, const PulseOptions& opts);
 

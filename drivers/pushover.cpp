@@ -136,34 +136,53 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   const auto t0 = Clock::now();
   PushoverSettings set = given;
   PushoverResult r;
-  // Limit analysis of the same blocks (towards -x: of their mirror image), on the model as
-  // built: lambda_ref for the servo stiffness, and whether the mechanism slides.
-  r.lambda_ref = 1.0;
-  r.lambda_ref_from = "none (1)";
-  bool slides = false;
-  {
-    // The settings are checked on the model before the settle (exit 2 at once).
-    const Simulation probe = make_simulation(config);
-    validate_pushover(probe.model, set);
-    const LimitResult la = limit_analysis(set.direction < 0.0 ? mirror_x(probe.model) : probe.model,
-                                          config.contact.friction, config.load.gravity, false);
+  // Limit analysis of the same blocks (towards -x: of their mirror image): lambda_ref for the
+  // servo stiffness, and whether the mechanism slides. On the model as built; with [supports],
+  // on the blocks where the support movement leaves them (limit_of_settled, as `capacity`).
+  auto read_limit = [&](const LimitResult& la) {
+    r.lambda_ref = 1.0;
+    r.lambda_ref_from = "none (1)";
+    bool slides = false;
     if (la.status == "optimal" && la.lambda_la > 0.0 && std::isfinite(la.lambda_la)) {
       r.lambda_ref = la.lambda_la;
       r.lambda_ref_from = "limit analysis";
       for (const MechanismJoint& j : la.mechanism) slides = slides || j.kind == "sliding";
     }
+    return slides;
+  };
+  bool slides = false;
+  {
+    // The settings are checked on the model before the settle (exit 2 at once).
+    const Simulation probe = make_simulation(config);
+    validate_pushover(probe.model, set);
+    slides = read_limit(limit_analysis(set.direction < 0.0 ? mirror_x(probe.model) : probe.model,
+                                       config.contact.friction, config.load.gravity, false));
   }
   // The technique (header comment): quasi-static unless the mechanism slides.
-  if (set.technique == "auto") {
-    set.criteria.quasi_static = !slides;
-    r.technique = slides ? "physical: the limit-analysis mechanism slides"
-                         : "quasi-static: the limit-analysis mechanism does not slide";
-  } else {
-    set.criteria.quasi_static = set.technique == "quasi-static";
-    r.technique = set.technique + " (asked)";
-  }
-  const SettledState settled = settle(config, set.criteria, quiet);
+  auto choose = [&](bool slide) {
+    if (set.technique == "auto") {
+      set.criteria.quasi_static = !slide;
+      r.technique = slide ? "physical: the limit-analysis mechanism slides"
+                          : "quasi-static: the limit-analysis mechanism does not slide";
+    } else {
+      set.criteria.quasi_static = set.technique == "quasi-static";
+      r.technique = set.technique + " (asked)";
+    }
+  };
+  choose(slides);
+  SettledState settled = settle(config, set.criteria, quiet);
   if (!settled.settled) throw RunError(unsettled_message(settled, set.criteria));
+  if (!config.supports.moves.empty()) {
+    // The moved structure decides; a technique it changes is settled and moved again under it.
+    const bool moved_slides =
+        read_limit(limit_of_settled(settled, config.contact.friction, set.direction));
+    if (moved_slides != slides && set.technique == "auto") {
+      choose(moved_slides);
+      settled = settle(config, set.criteria, quiet);
+      if (!settled.settled) throw RunError(unsettled_message(settled, set.criteria));
+      read_limit(limit_of_settled(settled, config.contact.friction, set.direction));
+    }
+  }
 
   r.settle_wall_s = settled.wall_s;
   r.quasi_static = set.criteria.quasi_static;

@@ -22,6 +22,24 @@ double max_free_displacement(const Model& model) {
   return std::sqrt(d2);
 }
 
+void refuse_absurd_plan(const Simulation& sim, double steps, const LoopOptions& opts) {
+  if (opts.limits.max_steps > 0 || !(steps > kMaxPlannedSteps)) return;
+  // The wall they imply: kProbeSteps steps of a copy, timed.
+  constexpr int kProbeSteps = 8;
+  Simulation probe = sim;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < kProbeSteps; ++k) advance(probe);
+  const double per_step = seconds_since(t0) / kProbeSteps;
+  std::ostringstream msg;
+  msg.precision(3);
+  msg << opts.label << ": solver.end_time = " << opts.end_time << " s at a time step of "
+      << sim.ctx.dt << " s (solver.dt, solver.dt_safety) is " << steps << " steps, about "
+      << steps * per_step << " s of wall at " << per_step << " s a step: above the "
+      << kMaxPlannedSteps << " steps a run plans without --max-steps (give --max-steps "
+      << std::llround(std::min(steps, 9e18)) << " to run it anyway)";
+  throw DeckError(msg.str());
+}
+
 LoopStats run_loop(Simulation& sim, const LoopOptions& opts,
                    const std::function<bool(const Simulation&)>& sample, const LoopStats& resume) {
   LoopStats stats = resume;
@@ -34,6 +52,7 @@ LoopStats run_loop(Simulation& sim, const LoopOptions& opts,
     msg << "cannot run to t = " << opts.end_time << " s with a time step of " << dt << " s";
     throw RunError(msg.str());
   }
+  refuse_absurd_plan(sim, steps_needed - static_cast<double>(sim.step), opts);
   auto steps_of = [dt](double interval) {
     return std::max(1LL, static_cast<long long>(std::llround(std::min(interval / dt, 1e15))));
   };

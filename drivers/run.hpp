@@ -43,6 +43,12 @@ namespace voussoir {
 // Largest displacement magnitude of any free node from its reference position [m].
 double max_free_displacement(const Model& model);
 
+// The most steps a run plans (solver.end_time / dt) without --max-steps: a masonry run takes
+// 1e4 to 1e7 (dt of 1e-6 to 1e-5 s over seconds); 1e8 steps is minutes to hours of wall, and
+// beyond that a deck whose step or end time is out of range (solver.dt_safety = 1e-9 planned
+// 1e10 steps) would run for days without a word.
+inline constexpr double kMaxPlannedSteps = 1e8;
+
 struct LoopStats {
   long long steps = 0;
   double wall_s = 0.0;
@@ -67,6 +73,11 @@ struct LoopOptions {
   bool checkpoint_at_end = false;
   std::function<void(const Simulation&, const LoopStats&)> checkpoint;
 };
+
+// Refuses (DeckError, exit 2) a loop whose `steps` still to run exceed kMaxPlannedSteps when
+// opts.limits.max_steps is not given, naming the steps and the wall they imply (a few steps of
+// a copy of `sim`, timed); --max-steps N runs it (and fails it after N steps).
+void refuse_absurd_plan(const Simulation& sim, double steps, const LoopOptions& opts);
 
 // Advances from sim.step until `end_time`, calling `sample(sim)` every `sample_every` seconds
 // of simulated time (steps that are multiples of the sample interval, and the last step), and

@@ -36,8 +36,8 @@ void prescribe_supports(const Config& config, Simulation& sim) {
     const bool exists = m.block >= 0 && std::size_t(m.block) < blocks.size();
     if (!exists || !blocks[std::size_t(m.block)].fixed) {
       std::ostringstream msg;
-      msg << config.deck_path << ": supports.moves[" << k << "].block = " << m.block
-          << ": expected a fixed block (";
+      msg << (m.where.empty() ? config.deck_path + ": " : m.where) << "supports.moves[" << k
+          << "].block = " << m.block << ": expected a fixed block (";
       if (!exists)
         msg << "the model has blocks 0 to " << blocks.size() - 1;
       else

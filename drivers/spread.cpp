@@ -111,7 +111,8 @@ SpreadResult run_spread(const Config& given, const SpreadOptions& opts, bool qui
   std::size_t slot = config.supports.moves.size();
   for (std::size_t k = 0; k < config.supports.moves.size(); ++k)
     if (config.supports.moves[k].block == res.block) slot = k;
-  if (slot == config.supports.moves.size()) config.supports.moves.push_back({res.block, 0, 0, 0});
+  if (slot == config.supports.moves.size())
+    config.supports.moves.push_back({res.block, 0, 0, 0, ""});
   const SupportMoveConfig base = config.supports.moves[slot];
 
   for (const bool min : {true, false}) {

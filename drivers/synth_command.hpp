@@ -25,7 +25,9 @@ struct SynthOptions {
 };
 
 // Checks the options (DeckError naming the option and its value: exit 2), makes the records,
-// writes DIR/synth_NN.AT2, DIR/spectra.csv, the plot and the JSON; prints a summary. Returns 0.
+// writes DIR/synth_NN.AT2, DIR/spectra.csv, the plot and the JSON; prints a summary. Returns 0
+// when the set meets EN 1998-1 3.2.3.1.2 (4) (mean spectrum >= 0.9 x the target over --range,
+// mean PGA >= ag S); otherwise, everything written, throws RunError naming what failed (exit 1).
 int command_synth(const SynthOptions& opts);
 
 }  // namespace voussoir

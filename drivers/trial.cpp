@@ -266,8 +266,9 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
     if (info.sample || ends) sync_rigid_nodes(sim.model);
     if (spec.on_step) spec.on_step(sim, info);
     if (!info.sample && !(info.last && spec.sample_last)) {
-      // The last step of a run that ends off the sample grid is still guarded.
-      if (ends)
+      // The last step of a run that ends off the sample grid is still guarded, and so is the
+      // step that reaches --max-steps (a sample may lie far beyond it at a tiny step).
+      if (ends || (spec.limits.max_steps > 0 && sim.step - step_start >= spec.limits.max_steps))
         for (auto& g : guards) g->check(clock_probe());
       continue;
     }

@@ -429,6 +429,7 @@ const std::vector<KeySpec>& key_table() {
                if (i == nullptr || i->get() < 0 || i->get() > std::numeric_limits<int>::max())
                  bad(field, v, "a block index (an integer >= 0)");
                m.block = static_cast<int>(i->get());
+               m.where = r.where(r.key, &v);
                for (const SupportMoveConfig& o : c.supports.moves)
                  if (o.block == m.block) bad(field, v, "each block at most once");
                continue;

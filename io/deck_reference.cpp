@@ -99,7 +99,8 @@ const std::map<std::string, std::string>& meanings() {
       {"solver.max_iterations",
        "nscd: most Gauss-Seidel sweeps a step (a step that reaches it is counted unconverged)"},
       // [load]
-      {"load.gravity", "gravity g, downward"},
+      {"load.gravity",
+       "gravity g, downward (0: a weightless deck, which only `check` and `run` take)"},
       {"load.lambda", "horizontal body load factor of `run` (x gravity)"},
       {"load.gravity_ramp",
        "`run`: gravity and lambda g brought on together, linearly, over this time (0: from "

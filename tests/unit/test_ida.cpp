@@ -164,6 +164,77 @@ TEST(Fragility, BootstrapIntervalOfTheMedian) {
   EXPECT_NEAR(width, normal_width, 0.25 * normal_width);
 }
 
+// ln(1 - Phi(z)) stays finite where erfc underflows (z ~ 38 and beyond, which the beta search
+// reaches with a censored record far above a narrow fit): against the first terms of Mills'
+// ratio, -z^2/2 - ln(z sqrt(2 pi)) + ln(1 - 1/z^2 + 3/z^4), whose next term is 15/z^6; and
+// without a jump where it changes method (z = 30).
+TEST(Fragility, LogSurvivalFarInTheUpperTail) {
+  for (const double z : {40.0, 100.0, 1e3, 1e5}) {
+    const double want = -0.5 * z * z - std::log(z * std::sqrt(2.0 * std::numbers::pi)) +
+                        std::log(1.0 - 1.0 / (z * z) + 3.0 / (z * z * z * z));
+    const double got = log_normal_survival(z);
+    ASSERT_TRUE(std::isfinite(got)) << z;
+    // (Plus the rounding of numbers of size z^2 / 2.)
+    EXPECT_NEAR(got, want, 20.0 / std::pow(z, 6.0) + 4e-16 * std::abs(want)) << z;
+  }
+  // Across z = 30: the slope there is about -30, so 1e-9 apart the values differ by 3e-8.
+  EXPECT_NEAR(log_normal_survival(30.0 - 1e-9), log_normal_survival(30.0), 1e-7);
+  // Below, the library's erfc: ln(1 - Phi(0)) = ln 1/2, and the lower tail tends to 0.
+  EXPECT_DOUBLE_EQ(log_normal_survival(0.0), std::log(0.5));
+  EXPECT_NEAR(log_normal_survival(-40.0), 0.0, 1e-300);
+}
+
+// A record that collapses at every intensity tried, down to the smallest x (drivers/pulse.hpp
+// kMinAmplitude), enters the fit censored below: ln Phi(z). The fit is the maximum of that
+// likelihood: no point of a fine grid around it does better, and the record pulls the median
+// down.
+TEST(Fragility, RecordCensoredBelowEntersAsAnUpperBound) {
+  const std::vector<IntensitySample> collapsed = {
+      {0.5, false}, {0.8, false}, {1.0, false}, {1.3, false}};
+  std::vector<IntensitySample> with = collapsed;
+  with.push_back({0.3, false, true});
+  const LognormalFit plain = fit_lognormal(collapsed), fit = fit_lognormal(with);
+  ASSERT_TRUE(plain.ok && fit.ok);
+  EXPECT_EQ(fit.censored, 1);
+  EXPECT_LT(fit.median, plain.median);
+  auto log_l = [&](double mu, double beta) {
+    double sum = 0.0;
+    for (const IntensitySample& s : with) {
+      const double z = (std::log(s.im) - mu) / beta;
+      sum +=
+          s.below ? std::log(0.5 * std::erfc(-z / std::sqrt(2.0))) : -std::log(beta) - 0.5 * z * z;
+    }
+    return sum;
+  };
+  const double best = log_l(std::log(fit.median), fit.beta);
+  for (int i = -20; i <= 20; ++i)
+    for (int k = -20; k <= 20; ++k) {
+      const double mu = std::log(fit.median) + 0.01 * i, beta = fit.beta * (1.0 + 0.01 * k);
+      EXPECT_LE(log_l(mu, beta), best + 1e-12) << "mu " << mu << ", beta " << beta;
+    }
+  EXPECT_THROW(fit_lognormal({{0.3, false}, {0.5, false}, {0.4, true, true}}),
+               std::invalid_argument);
+}
+
+// Every resample counts: three records, one of which never collapsed. 1 resample in 27 draws
+// it three times and has no collapse at all: its median lies above every intensity run, so the
+// 95% interval (whose upper end is the 97.5% quantile) is unbounded above; 6 in 27 draw
+// one collapse intensity only and enter at it.
+TEST(Fragility, BootstrapKeepsResamplesWithoutAFit) {
+  const std::vector<IntensitySample> s = {{0.4, false}, {0.6, false}, {2.0, true}};
+  const MedianInterval ci = bootstrap_median(s, 1000, 3, 0.95);
+  EXPECT_EQ(ci.resamples, 1000);
+  EXPECT_GT(ci.without_fit, 0);
+  EXPECT_TRUE(std::isinf(ci.hi)) << ci.hi;
+  EXPECT_GE(ci.lo, 0.4);
+  EXPECT_LT(ci.lo, 0.6);
+  // Two collapses only: every resample holds at most two distinct values; none is unbounded.
+  const MedianInterval two = bootstrap_median({{0.4, false}, {0.6, false}}, 1000, 3, 0.95);
+  EXPECT_EQ(two.resamples, 1000);
+  EXPECT_DOUBLE_EQ(two.lo, 0.4);
+  EXPECT_DOUBLE_EQ(two.hi, 0.6);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The command.
 
@@ -295,8 +366,32 @@ TEST(Ida, SlenderBlockUnderThreeRecords) {
     // A record whose peak stays below lambda* g cannot tip the block.
     EXPECT_GE(lo, 0.2);
   }
+  // SPEC section 2's fields.
+  for (const char* key : {"im", "period", "records", "fragility", "ranks", "wall_s"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key : {"file", "collapse_im", "bracket", "trials", "wall_s"})
+    EXPECT_TRUE(j.at("records")[0].contains(key)) << key;
   ASSERT_FALSE(j.at("fragility").is_null());
-  EXPECT_GT(j.at("fragility").at("beta").get<double>(), 0.0);
+  const nlohmann::json& fr = j.at("fragility");
+  for (const char* key : {"median", "beta", "median_ci"}) EXPECT_TRUE(fr.contains(key)) << key;
+  // Every record bracketed, none censored: the fit is the closed form of the records' collapse
+  // intensities, median exp(mean ln x) and beta the 1/n deviation of ln x.
+  double mean = 0.0, var = 0.0;
+  for (const nlohmann::json& rec : j.at("records"))
+    mean += std::log(rec.at("collapse_im").get<double>());
+  mean /= 3.0;
+  for (const nlohmann::json& rec : j.at("records"))
+    var += std::pow(std::log(rec.at("collapse_im").get<double>()) - mean, 2.0);
+  EXPECT_NEAR(fr.at("median").get<double>(), std::exp(mean), 1e-12 * std::exp(mean));
+  EXPECT_NEAR(fr.at("beta").get<double>(), std::sqrt(var / 3.0), 1e-12);
+  EXPECT_EQ(fr.at("censored").get<int>(), 0);
+  // The interval of the median: two numbers around it, or null where the records leave it
+  // unbounded.
+  ASSERT_EQ(fr.at("median_ci").size(), 2u);
+  if (!fr.at("median_ci")[0].is_null())
+    EXPECT_LE(fr.at("median_ci")[0].get<double>(), fr.at("median").get<double>());
+  if (!fr.at("median_ci")[1].is_null())
+    EXPECT_GE(fr.at("median_ci")[1].get<double>(), fr.at("median").get<double>());
 
   // Sa(0.5 s): the same PGAs, intensities scaled by the record's own ratio.
   const double period = 0.5;

@@ -433,5 +433,34 @@ TEST(LimitCommand, WritesLambdaAndMechanismJson) {
   std::remove(out.c_str());
 }
 
+// `limit --thrust min|max` through the program: its JSON holds "thrust_min" / "thrust_max" in N
+// per out_of_plane, the LP's thrust of the same blocks and friction (limit_thrust), no
+// "lambda_la"; min below max.
+TEST(LimitCommand, ThrustBoundsInTheJson) {
+  const std::string out = ::testing::TempDir() + "limit_thrust.json";
+  const Config config = load_deck(case_path("circular_arch"), {});
+  const Model m = build_model(scene_params(config));
+  double thrust[2];
+  const char* bound[2] = {"min", "max"};
+  for (int k = 0; k < 2; ++k) {
+    const std::string cmd = std::string(VOUSSOIR_BINARY) + " limit " + case_path("circular_arch") +
+                            " --thrust " + bound[k] + " --quiet --json " + out + " > /dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::ifstream in(out);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    const std::string key = std::string("thrust_") + bound[k];
+    ASSERT_TRUE(j.contains(key)) << j.dump();
+    EXPECT_FALSE(j.contains("lambda_la"));
+    EXPECT_FALSE(j.at("gravity_only").get<bool>());
+    thrust[k] = j.at(key).get<double>();
+    const LimitResult lp = limit_thrust(m, config.contact.friction, config.load.gravity,
+                                        k == 0 ? ThrustBound::Min : ThrustBound::Max);
+    EXPECT_NEAR(thrust[k], lp.thrust, 1e-9 * std::abs(lp.thrust)) << key;
+  }
+  EXPECT_GT(thrust[0], 0.0);
+  EXPECT_GT(thrust[1], thrust[0]);
+  std::remove(out.c_str());
+}
+
 }  // namespace
 }  // namespace voussoir

@@ -11,13 +11,63 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "drivers/pulse.hpp"
+#include "io/deck.hpp"
+
 namespace {
+
+// A structure that collapses at every amplitude (here: a fall criterion that any motion meets,
+// 1e-12 L_ref) stops the search at the smallest amplitude it steps down to (kMinAmplitude):
+// no bisection from [0, hi], which a relative tolerance never closes (about 1000 runs, until
+// hi underflows). The point says so, with A_c the smallest amplitude run, lo 0, and every run
+// collapsed; the search's runs are the steps down and nothing else. `pulse --curve` and `ida`
+// share this search.
+TEST(PulseCurve, CollapseAtEveryAmplitudeStopsAtTheSmallestTried) {
+  using namespace voussoir;
+  const Config config = parse_deck(
+      "[model]\nkind = \"block\"\nwidth = 0.5\nheight = 1.0\n[material]\nmodel = \"rigid\"\n"
+      "[contact]\nfriction = 0.8\nnormal_stiffness = 1e10\n[load.base]\n"
+      "signal = \"windowed_sine\"\n",
+      "test");
+  PulseCriteria crit;
+  crit.fall_displacement = 1e-12;
+  crit.fall_rotation = 1e-15;
+  const SettledState settled = settle(config, crit.settle, true);
+  ASSERT_TRUE(settled.settled);
+  for (const AmplitudeSearch kind : {AmplitudeSearch::Step, AmplitudeSearch::Bisect}) {
+    AmplitudeSearchOptions search;
+    search.search = kind;
+    search.start = 0.05;
+    search.step = 0.5;
+    const double growth = kind == AmplitudeSearch::Step ? 1.0 + search.step : kBracketGrowth;
+    const CurvePoint p =
+        find_collapse_amplitude(settled, config.load.base, 5.0, search, crit, true);
+    EXPECT_TRUE(p.collapses_everywhere);
+    EXPECT_TRUE(p.bracketed);
+    double smallest = search.start;
+    for (const PulseResult& r : p.runs) {
+      EXPECT_TRUE(r.collapsed) << "A = " << r.amplitude_g;
+      smallest = std::min(smallest, r.amplitude_g);
+    }
+    EXPECT_EQ(p.amplitude, smallest);
+    EXPECT_EQ(p.hi, smallest);
+    EXPECT_EQ(p.lo, 0.0);
+    // start / growth^k for k = 0 .. K, K the first step at or below kMinAmplitude.
+    const int steps = static_cast<int>(
+        std::ceil(std::log(search.start / kMinAmplitude) / std::log(growth) - 1e-12));
+    EXPECT_EQ(p.trials, steps + 1);
+    EXPECT_LE(smallest, kMinAmplitude);
+    EXPECT_GT(smallest * growth, kMinAmplitude);
+    EXPECT_NE(point_note(p).find(kCollapsesEverywhere), std::string::npos) << point_note(p);
+  }
+}
 
 TEST(PulseCurve, RigidBlockCollapseAmplitudes) {
   const std::string dir = ::testing::TempDir();

@@ -9,12 +9,15 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "drivers/pushover.hpp"
 #include "drivers/setup.hpp"
 #include "io/deck.hpp"
+#include "limit/limit_analysis.hpp"
 #include "subprocess.hpp"
 
 namespace voussoir {
@@ -194,6 +197,116 @@ TEST(Pushover, EquivalentSdofOfATwoBlockMechanism) {
   EXPECT_NEAR(s.d_star_u, 0.4 * 0.21, 1e-12);
 }
 
+// The semicircular arch's four-hinge mechanism, its SDOF quantities by hand. The hinges are the
+// limit analysis' (pivots A, B, C, D from the left), and the pushover opens the same four first;
+// the voussoirs between them form three rigid links: A-B turning about A at the rate 1, B-C
+// about the intersection I of the lines AB and DC (its rate w2 from B's velocity,
+// w1 (B - A) = w2 (B - I)), C-D about D (w3 from C's, w2 (C - I) = w3 (C - D)); the blocks
+// between a springing and its hinge stay. A centroid P of a link turning at w about O moves by
+// dx = -w (P_y - O_y); normalised at the crown block, with the blocks' weights P_i:
+//     M* = (sum P dx)^2 / (g sum P dx^2),  e* = g M* / sum P,  d* / d = sum P dx^2 / sum P dx,
+// which equivalent_sdof must give for these dx (e* = 0.76: not the single block's 1).
+TEST(Pushover, EquivalentSdofOfTheSemicircularArchsFourHingeMechanism) {
+  const Config config =
+      load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml", {});
+  const Model model = make_simulation(config).model;
+  const double g = config.load.gravity;
+  const LimitResult la = limit_analysis(model, config.contact.friction, g, false);
+  std::vector<Pt> pivot;
+  std::vector<int> joints;
+  for (const MechanismJoint& j : la.mechanism) {
+    ASSERT_EQ(j.kind, "hinge");
+    pivot.push_back({j.x, j.y});
+    joints.push_back(j.joint);
+  }
+  ASSERT_EQ(pivot.size(), 4u);
+  // From the left springing (angle 180 deg) to the right (0 deg).
+  auto angle = [](double x, double y) { return std::atan2(y, x); };
+  std::sort(pivot.begin(), pivot.end(),
+            [&](const Pt& a, const Pt& b) { return angle(a.x, a.y) > angle(b.x, b.y); });
+  const Pt A = pivot[0], B = pivot[1], C = pivot[2], D = pivot[3];
+  // I = A + s (B - A) on the line DC: cross(I - D, C - D) = 0.
+  const Pt ab{B.x - A.x, B.y - A.y}, dc{C.x - D.x, C.y - D.y};
+  const double s_i = ((D.x - A.x) * dc.y - (D.y - A.y) * dc.x) / (ab.x * dc.y - ab.y * dc.x);
+  const Pt I{A.x + s_i * ab.x, A.y + s_i * ab.y};
+  auto dot = [](Pt u, Pt v) { return u.x * v.x + u.y * v.y; };
+  const Pt bi{B.x - I.x, B.y - I.y}, ci{C.x - I.x, C.y - I.y}, cd{C.x - D.x, C.y - D.y};
+  const double w1 = 1.0, w2 = w1 * dot(ab, bi) / dot(bi, bi), w3 = w2 * dot(ci, cd) / dot(cd, cd);
+  const int crown = default_control_block(model);
+  std::vector<double> weight(model.blocks.size(), 0.0), dx(model.blocks.size(), 0.0);
+  for (std::size_t b = 0; b < model.blocks.size(); ++b) {
+    const Block& blk = model.blocks[b];
+    if (blk.fixed) continue;
+    const double px = model.rigid.cx0[Index(b)], py = model.rigid.cy0[Index(b)];
+    const double t = angle(px, py);
+    weight[b] = blk.mass * g;
+    if (t > angle(A.x, A.y) || t < angle(D.x, D.y))
+      dx[b] = 0.0;  // between a springing and its hinge: at rest
+    else if (t > angle(B.x, B.y))
+      dx[b] = -w1 * (py - A.y);
+    else if (t > angle(C.x, C.y))
+      dx[b] = -w2 * (py - I.y);
+    else
+      dx[b] = -w3 * (py - D.y);
+  }
+  const double dk = dx[std::size_t(crown)];
+  double sum_p = 0.0, sum_pd = 0.0, sum_pd2 = 0.0;
+  for (std::size_t b = 0; b < dx.size(); ++b) {
+    dx[b] /= dk;
+    sum_p += weight[b], sum_pd += weight[b] * dx[b], sum_pd2 += weight[b] * dx[b] * dx[b];
+  }
+  const double m_star = sum_pd * sum_pd / (g * sum_pd2);
+  const double e_star = g * m_star / sum_p, factor = sum_pd2 / sum_pd;
+  ASSERT_LT(e_star, 0.9);  // a mechanism, not one block: e* = 1 would test nothing
+  const std::vector<PushoverPoint> curve = {
+      {0.0, 0.0, 0.0, 0.0}, {0.01, 0.29, 1.0, 0.29}, {0.05, 0.0, 2.0, 0.0}};
+  const Sdof s = equivalent_sdof(weight, dx, crown, curve, g, true, 0.05);
+  ASSERT_TRUE(s.valid);
+  std::printf("[pushover arch] four-hinge mechanism: e* %.4f, M* %.2f kg, d*/d %.4f\n", e_star,
+              m_star, factor);
+  EXPECT_NEAR(s.participating_mass_ratio, e_star, 1e-12);
+  EXPECT_NEAR(s.participating_mass, m_star, 1e-9 * m_star);
+  EXPECT_NEAR(s.factor, factor, 1e-12);
+  EXPECT_NEAR(s.a_star[1], 0.29 * g / e_star, 1e-12);
+  EXPECT_NEAR(s.d_star[2], 0.05 * factor, 1e-12);
+  EXPECT_NEAR(s.d_star_u, 0.4 * 0.05 * factor, 1e-12);
+
+  // The pushover opens these four joints first (the order aside).
+  PushoverSettings set;
+  set.stop_fraction = 0.8;
+  const PushoverResult r = run_pushover(config, set, true);
+  ASSERT_GE(r.hinges.size(), 4u);
+  std::vector<int> first;
+  for (std::size_t i = 0; i < 4; ++i) first.push_back(r.hinges[i].hinge.joint);
+  std::sort(first.begin(), first.end());
+  std::sort(joints.begin(), joints.end());
+  EXPECT_EQ(first, joints);
+}
+
+// [supports]: the servo's lambda_la and the technique come from the limit analysis of the moved
+// blocks, as capacity's seed does (limit_of_settled of the same settle), not of the blocks as
+// built (spread by 5 mm, lambda_la falls).
+TEST(Pushover, WithSupportsTheLimitAnalysisIsOfTheMovedBlocks) {
+  const std::string deck = std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml";
+  const Config config = load_deck(deck, {"supports.moves=[{block = 11, dx = -0.005}, "
+                                         "{block = 12, dx = 0.005}]",
+                                         "supports.ramp=0.1"});
+  PushoverSettings set;
+  set.max_displacement = 1e-4;  // the reference is set before the run: a short one
+  const PushoverResult r = run_pushover(config, set, true);
+  TrialCriteria crit;
+  crit.quasi_static = true;
+  const SettledState settled = settle(config, crit, true);
+  ASSERT_TRUE(settled.settled);
+  const double moved = limit_of_settled(settled, config.contact.friction, 1.0).lambda_la;
+  const double built =
+      limit_analysis(make_simulation(config).model, config.contact.friction, 9.81, false).lambda_la;
+  ASSERT_LT(moved, 0.99 * built);
+  EXPECT_EQ(r.lambda_ref_from, "limit analysis");
+  EXPECT_DOUBLE_EQ(r.lambda_ref, moved);
+  EXPECT_TRUE(r.quasi_static);
+}
+
 TEST(Pushover, DefaultControlIsTheCrownOfAnArch) {
   const Config config =
       load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml", {});
@@ -262,6 +375,106 @@ TEST(Pushover, CommandRefusesBadOptionsWithStatusTwo) {
     EXPECT_EQ(r.status, 2) << named << ": " << r.err;
     EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
   }
+  std::filesystem::remove_all(dir);
+}
+
+// The program's JSON against SPEC's names, towards -x and +x, with its CSV: a 0.25 x 1 m rigid
+// block on stiff joints (its rocking curve: peak b/h at d ~ 0, lambda 0 at the corner's
+// tipping point). -x is the mirror of +x: the same curve within 1e-3 b/h. The CSV holds the
+// JSON's curve and its SDOF curve (one block: d* = d, a* = lambda g). --dynamic runs the
+// physical technique and finds the same peak within 2% of b/h; a block sliding at mu = 0.15
+// < b/h runs it unasked, its peak mu within 2% of it.
+nlohmann::json pushover_cli(const std::filesystem::path& dir, const std::string& name,
+                            const std::vector<std::string>& extra,
+                            std::string* csv_text = nullptr) {
+  std::vector<std::string> args = {VOUSSOIR_BINARY,
+                                   "pushover",
+                                   std::string(VOUSSOIR_SOURCE_DIR) + "/cases/block.toml",
+                                   "-q",
+                                   "--set",
+                                   "model.width=0.25",
+                                   "--set",
+                                   "material.model=\"rigid\"",
+                                   "--set",
+                                   "contact.normal_stiffness=1e14",
+                                   "--set",
+                                   "contact.shear_stiffness=1e14",
+                                   "--json",
+                                   (dir / (name + ".json")).string(),
+                                   "--csv",
+                                   (dir / (name + ".csv")).string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const testing::ProcessResult r =
+      testing::run_process(args, {.wall_s = 300, .cpu_s = 600}, (dir / name).string());
+  EXPECT_TRUE(r.exited && r.status == 0) << name << ": " << r.describe() << r.err;
+  if (csv_text) *csv_text = testing::read_text_file((dir / (name + ".csv")).string());
+  return nlohmann::json::parse(testing::read_text_file((dir / (name + ".json")).string()));
+}
+
+TEST(Pushover, CommandJsonCsvAndDirections) {
+  const double b_over_h = 0.25;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "voussoir_pushover_json";
+  std::filesystem::create_directories(dir);
+  std::string csv;
+  const nlohmann::json minus = pushover_cli(dir, "minus", {"--direction", "-x"}, &csv);
+  // SPEC section 2's fields.
+  for (const char* key :
+       {"curve", "peak", "ultimate_displacement", "control", "sdof", "hinges", "wall_s"})
+    EXPECT_TRUE(minus.contains(key)) << key;
+  for (const char* key : {"displacement", "lambda"})
+    EXPECT_TRUE(minus.at("curve").at(0).contains(key)) << key;
+  EXPECT_TRUE(minus.at("peak").contains("lambda") && minus.at("peak").contains("displacement"));
+  EXPECT_TRUE(minus.at("control").contains("block") && minus.at("control").contains("point"));
+  for (const char* key : {"participating_mass_ratio", "e_star", "curve", "d_star_u"})
+    EXPECT_TRUE(minus.at("sdof").contains(key)) << key;
+  EXPECT_TRUE(minus.at("sdof").at("curve").at(0).contains("d_star"));
+  EXPECT_TRUE(minus.at("sdof").at("curve").at(0).contains("a_star"));
+  EXPECT_EQ(minus.at("direction"), "-x");
+  EXPECT_EQ(minus.at("technique"), "quasi-static: the limit-analysis mechanism does not slide");
+
+  const nlohmann::json plus = pushover_cli(dir, "plus", {});
+  const double peak = plus.at("peak").at("lambda").get<double>();
+  EXPECT_NEAR(peak, b_over_h, 0.02 * b_over_h);
+  EXPECT_NEAR(minus.at("peak").at("lambda").get<double>(), peak, 1e-3 * b_over_h);
+  EXPECT_NEAR(minus.at("ultimate_displacement").get<double>(),
+              plus.at("ultimate_displacement").get<double>(),
+              1e-3 * plus.at("ultimate_displacement").get<double>());
+  // Towards -x the displacement along the load is positive, as towards +x.
+  EXPECT_GT(minus.at("curve").back().at("displacement").get<double>(), 0.0);
+
+  // The CSV: the JSON's curve, row by row, and its SDOF curve (one block: d* = d, a* = lambda g).
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "displacement,lambda,time,d_star,a_star");
+  const nlohmann::json& curve = minus.at("curve");
+  std::size_t row = 0;
+  while (std::getline(in, line)) {
+    double v[5];
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4]),
+              5)
+        << line;
+    ASSERT_LT(row, curve.size());
+    EXPECT_NEAR(v[0], curve[row].at("displacement").get<double>(), 1e-8);
+    EXPECT_NEAR(v[1], curve[row].at("lambda").get<double>(), 1e-8);
+    EXPECT_NEAR(v[3], v[0], 1e-8);
+    EXPECT_NEAR(v[4], v[1] * 9.81, 1e-7);
+    ++row;
+  }
+  EXPECT_EQ(row, curve.size());
+
+  const nlohmann::json dynamic = pushover_cli(dir, "dynamic", {"--dynamic"});
+  EXPECT_EQ(dynamic.at("technique"), "dynamic (asked)");
+  EXPECT_FALSE(dynamic.at("quasi_static").get<bool>());
+  EXPECT_NEAR(dynamic.at("peak").at("lambda").get<double>(), b_over_h, 0.02 * b_over_h);
+
+  const double mu = 0.15;
+  const nlohmann::json slides =
+      pushover_cli(dir, "slides", {"--set", "contact.friction=0.15", "--max-displacement", "0.05"});
+  EXPECT_EQ(slides.at("technique"), "physical: the limit-analysis mechanism slides");
+  EXPECT_FALSE(slides.at("quasi_static").get<bool>());
+  EXPECT_NEAR(slides.at("peak").at("lambda").get<double>(), mu, 0.02 * mu);
   std::filesystem::remove_all(dir);
 }
 

@@ -172,6 +172,24 @@ TEST(RecordsBaseline, RemovesAnOffsetAndALinearDrift) {
   std::printf("baseline: offset 0.01 g + 0.002 g/s, linear: v = %.3e m/s, d = %.3e m\n", v, d);
   EXPECT_LT(std::abs(v), 1e-3);  // of 5.89 m/s
   EXPECT_LT(std::abs(d), 1e-3);  // of 45.8 m
+  // A parabolic drift on top, 0.0002 g/s^2 t^2: the linear correction leaves a part of it, the
+  // quadratic one removes it.
+  rec = drifting_record(0.01 * kG, 0.002 * kG);
+  for (std::size_t k = 0; k < rec.accel.size(); ++k)
+    rec.accel[k] += 0.0002 * kG * rec.time[k] * rec.time[k];
+  Accelerogram linear = rec;
+  correct_baseline(linear, baseline_degree("linear"));
+  double v_lin, d_lin;
+  final_motion(linear, v_lin, d_lin);
+  correct_baseline(rec, baseline_degree("quadratic"));
+  final_motion(rec, v, d);
+  std::printf(
+      "baseline: parabolic drift, linear: v = %.3e m/s, d = %.3e m; quadratic: v = %.3e "
+      "m/s, d = %.3e m\n",
+      v_lin, d_lin, v, d);
+  EXPECT_LT(std::abs(v), 1e-3);
+  EXPECT_LT(std::abs(d), 1e-3);
+  EXPECT_GT(std::abs(d_lin), 0.1);
   // "none" leaves the record as it is.
   rec = drifting_record(0.01 * kG, 0.0);
   const Accelerogram same = rec;

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "contact/joint_stiffness.hpp"
+#include "contact/rigid_contact.hpp"
 #include "core/rigid.hpp"
 #include "drivers/setup.hpp"
 #include "io/checkpoint.hpp"
@@ -169,9 +171,59 @@ TEST(Rigid, DroppedBlockReboundsToRestitutionSquaredOfItsHeight) {
     double worst = 0.0;
     const double h = 0.01;
     const double up = rebound_height(e, h, &worst);
+    std::printf("[drop] restitution %.1f: rebound %+.1f%% of e^2 h\n", e,
+                100.0 * (up / (h * e * e) - 1.0));
     EXPECT_NEAR(up / h, e * e, 0.05 * e * e) << "restitution " << e;
     EXPECT_LT(worst, 0.01) << "restitution " << e;
   }
+}
+
+// No tension (SPEC section 1): a block pressed 1e-7 m into its joint and leaving it at 0.1 m/s,
+// with a strong dashpot (restitution 0.1), gets from the joint a normal force that is never a
+// pull: the dashpot's 1e5 N would pull against the spring's 250 N; it is held to the spring's
+// push, the total zero. Approaching, the dashpot adds to the spring.
+TEST(Rigid, SeparatingJointsDashpotNeverPulls) {
+  Simulation sim =
+      deck_sim(block_deck("friction = 0.8\nnormal_stiffness = 1e10\nshear_stiffness = 1e10\n"
+                          "restitution = 0.1"));
+  Model& m = sim.model;
+  const Index b = free_block(m);
+  const double depth = 1e-7, spring = 1e10 * 0.25 * depth;  // kn t_z |O| [N]
+  advance(sim);                                             // the contact detection
+  auto normal_on_block = [&](double vy) {
+    set_rigid_state(m, b, m.rigid.cx0[b], m.rigid.cy0[b] - depth, 0.0, 0.0, vy, 0.0);
+    double fy = 0.0;
+    for (const BlockPairForce& f : sim.contact.block_pair_forces(m, sim.ctx.dt))
+      fy += f.block_b == b ? f.force.y : -f.force.y;
+    return fy;
+  };
+  EXPECT_NEAR(normal_on_block(0.0), spring, 1e-9 * spring);
+  const double leaving = normal_on_block(0.1);
+  EXPECT_GE(leaving, -1e-9 * spring) << "the joint pulls the leaving block";
+  EXPECT_LE(leaving, spring);
+  EXPECT_GT(normal_on_block(-0.1), spring) << "the dashpot resists an approach";
+}
+
+// The restitution of a normal impact on a spring and a dashpot that pushes only, against the
+// oscillator x'' + 2 zeta x' + x = 0 integrated here (x(0) = 0, x'(0) = 1, semi-implicit Euler
+// at 1e-6) until the force x + 2 zeta x' vanishes; its inverse gives the zeta back; and it
+// exceeds the restitution of the dashpot that may pull, exp(-pi zeta / sqrt(1 - zeta^2)).
+TEST(Rigid, NoTensionRestitutionOfTheJointDashpot) {
+  for (const double zeta : {0.05, 0.2, 0.5, 0.8, 0.99}) {
+    double x = 0.0, v = 1.0;
+    const double h = 1e-6;
+    while (!(x > 0.0 && x + 2.0 * zeta * v < 0.0)) {
+      v -= h * (x + 2.0 * zeta * v);
+      x += h * v;
+    }
+    const double e = no_tension_restitution(zeta);
+    EXPECT_NEAR(e, -v, 1e-5) << "zeta " << zeta;
+    EXPECT_NEAR(no_tension_damping_ratio(e), zeta, 1e-12) << "zeta " << zeta;
+    EXPECT_GT(e, std::exp(-std::numbers::pi * zeta / std::sqrt(1.0 - zeta * zeta)));
+  }
+  EXPECT_DOUBLE_EQ(no_tension_restitution(1.0), std::exp(-2.0));
+  EXPECT_EQ(no_tension_damping_ratio(1.0), 0.0);
+  EXPECT_EQ(no_tension_damping_ratio(0.0), 1.0);
 }
 
 TEST(Rigid, RestartContinuesBitForBit) {
