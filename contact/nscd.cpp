@@ -102,7 +102,8 @@ void piece_contact_points(const Vec2* p, int np, std::uint32_t p_outline, const 
   const Face fq = best_face(q, nq, q_outline, p, np, any);
   if (any > alert) return;  // a separating line farther than the alert distance
   if (fp.edge < 0 && fq.edge < 0) return;
-  const bool ref_q = fp.edge < 0 || (fq.edge >= 0 && fq.separation > fp.separation + kFaceSwitch * alert);
+  const bool ref_q =
+      fp.edge < 0 || (fq.edge >= 0 && fq.separation > fp.separation + kFaceSwitch * alert);
   const Vec2* r = ref_q ? q : p;
   const int nr = ref_q ? nq : np;
   const Vec2* in = ref_q ? p : q;
@@ -125,14 +126,16 @@ void piece_contact_points(const Vec2* p, int np, std::uint32_t p_outline, const 
   // Clip the incident edge to the reference face's extent: t.(x - r1) >= 0, t.(x - r2) <= 0.
   auto clip = [&](double d0, double d1) {  // keeps the part with d <= 0
     if (d0 > 0.0 && d1 > 0.0) return false;
-    if (d0 > 0.0) v[0] = v[0] + (d0 / (d0 - d1)) * (v[1] - v[0]);
-    else if (d1 > 0.0) v[1] = v[1] + (d1 / (d1 - d0)) * (v[0] - v[1]);
+    if (d0 > 0.0)
+      v[0] = v[0] + (d0 / (d0 - d1)) * (v[1] - v[0]);
+    else if (d1 > 0.0)
+      v[1] = v[1] + (d1 / (d1 - d0)) * (v[0] - v[1]);
     return true;
   };
   if (!clip(-dot(t, v[0] - r1), -dot(t, v[1] - r1))) return;
   if (!clip(dot(t, v[0] - r2), dot(t, v[1] - r2))) return;
-  const std::uint64_t face_bits = (std::uint64_t(ref_q) << 9) | (std::uint64_t(k) << 5) |
-                                  (std::uint64_t(inc) << 1);
+  const std::uint64_t face_bits =
+      (std::uint64_t(ref_q) << 9) | (std::uint64_t(k) << 5) | (std::uint64_t(inc) << 1);
   for (int c = 0; c < 2; ++c) {
     const double s = dot(n, v[c] - r1);
     if (s > alert) continue;
@@ -273,8 +276,8 @@ NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& befor
   for (std::size_t k = 0; k < n; ++k) {
     const ContactPoint& c = points_[k];
     local_velocity(c, before.data(), ra_x_[k], ra_y_[k], rb_x_[k], rb_y_[k], un0[k], ut0[k]);
-    u_min[k] = c.gap > 0.0 ? -c.gap / (settings.theta * h)
-                           : -settings.restitution * std::min(un0[k], 0.0);
+    u_min[k] =
+        c.gap > 0.0 ? -c.gap / (settings.theta * h) : -settings.restitution * std::min(un0[k], 0.0);
     out.penetration = std::max(out.penetration, -c.gap);
   }
   auto apply = [&](std::size_t k, double drn, double drt) { apply_impulse(k, drn, drt, inv, v); };
@@ -310,7 +313,8 @@ NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& befor
       const double* now = &v[3 * b];
       const double* was = &v_sweep[3 * b];
       const double dx = now[0] - was[0], dy = now[1] - was[1];
-      change = std::max(change, std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(now[2] - was[2]));
+      change =
+          std::max(change, std::sqrt(dx * dx + dy * dy) + radius_[b] * std::abs(now[2] - was[2]));
     }
     out.residual = change / v_scale;
     if (out.residual <= settings.tolerance) {
@@ -328,8 +332,9 @@ NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& befor
       // from where they were instead.
       double moved = 0.0;
       for (std::size_t b = 0; b < nb; ++b)
-        moved = std::max(moved, std::hypot(v[3 * b] - v_sweeps[3 * b], v[3 * b + 1] - v_sweeps[3 * b + 1]) +
-                                    radius_[b] * std::abs(v[3 * b + 2] - v_sweeps[3 * b + 2]));
+        moved = std::max(
+            moved, std::hypot(v[3 * b] - v_sweeps[3 * b], v[3 * b + 1] - v_sweeps[3 * b + 1]) +
+                       radius_[b] * std::abs(v[3 * b + 2] - v_sweeps[3 * b + 2]));
       if (!(moved <= kDirectReach * v_scale)) {
         rn_ = rn, rt_ = rt, v = v_sweeps;
         --out.direct_solves;
@@ -516,8 +521,8 @@ void NscdContact::solve_direct(const Model& model, const std::vector<double>& v_
     if (rn_[k] != 0.0 || rt_[k] != 0.0) apply_impulse(k, rn_[k], rt_[k], inv, v);
 }
 
-void NscdContact::apply_impulse(std::size_t k, double rn, double rt,
-                                const std::vector<double>& inv, std::vector<double>& v) const {
+void NscdContact::apply_impulse(std::size_t k, double rn, double rt, const std::vector<double>& inv,
+                                std::vector<double>& v) const {
   const ContactPoint& c = points_[k];
   const double px = rn * c.n.x - rt * c.n.y, py = rn * c.n.y + rt * c.n.x;
   double* va = &v[3 * std::size_t(c.a)];
@@ -572,7 +577,8 @@ void NscdContact::restore_state(const std::vector<char>& bytes) {
   if (in.get<std::uint64_t>() != kNscdTag) in.fail("not a non-smooth contact state");
   std::vector<std::uint64_t> keys = in.get_array<std::uint64_t>();
   std::vector<double> rn = in.get_array<double>(), rt = in.get_array<double>();
-  if (rn.size() != keys.size() || rt.size() != keys.size()) in.fail("key and impulse counts differ");
+  if (rn.size() != keys.size() || rt.size() != keys.size())
+    in.fail("key and impulse counts differ");
   // The next build matches its points to these by key, as after the step that saved them.
   points_.assign(keys.size(), ContactPoint{});
   for (std::size_t k = 0; k < keys.size(); ++k) points_[k].key = keys[k];

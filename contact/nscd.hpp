@@ -92,11 +92,11 @@ PointImpulse solve_point(double wnn, double wnt, double wtt, double qn, double q
 
 // One contact point (header), at the start of the step.
 struct ContactPoint {
-  Index a = 0, b = 0;       // blocks, a < b
-  Vec2 x;                   // the point, midway between the outlines [m]
-  Vec2 n;                   // unit normal from a into b
-  double gap = 0.0;         // g [m], negative when the outlines overlap
-  std::uint64_t key = 0;    // pieces and faces that made it (warm start)
+  Index a = 0, b = 0;     // blocks, a < b
+  Vec2 x;                 // the point, midway between the outlines [m]
+  Vec2 n;                 // unit normal from a into b
+  double gap = 0.0;       // g [m], negative when the outlines overlap
+  std::uint64_t key = 0;  // pieces and faces that made it (warm start)
 };
 
 // The contact points of two convex pieces p (np vertices, of block a) and q (of block b),
@@ -122,10 +122,10 @@ struct NscdStepResult {
   int iterations = 0;
   int direct_solves = 0;  // steps whose sweeps took the direct solve (0 or 1)
   bool converged = true;
-  double residual = 0.0;       // the last sweep's relative change of the impulses
-  double penetration = 0.0;    // largest overlap -g of a point at the start of the step [m]
-  int points = 0;              // contact points in the solve
-  int active = 0;              // points with r_n > 0
+  double residual = 0.0;     // the last sweep's relative change of the impulses
+  double penetration = 0.0;  // largest overlap -g of a point at the start of the step [m]
+  int points = 0;            // contact points in the solve
+  int active = 0;            // points with r_n > 0
   // The impulses' work over the step, split as the ledger books it [J] (header)
   double impact_dissipated = 0.0;
   double friction_dissipated = 0.0;

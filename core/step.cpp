@@ -154,7 +154,8 @@ void advance_nscd(Simulation& sim) {
   for (std::size_t b = 0; b < nb; ++b) {
     before[3 * b] = r.vx[b], before[3 * b + 1] = r.vy[b], before[3 * b + 2] = r.omega[b];
     if (model.blocks[b].fixed) continue;
-    k0 += r.mass[b] * (r.vx[b] * r.vx[b] + r.vy[b] * r.vy[b]) + r.inertia[b] * r.omega[b] * r.omega[b];
+    k0 += r.mass[b] * (r.vx[b] * r.vx[b] + r.vy[b] * r.vy[b]) +
+          r.inertia[b] * r.omega[b] * r.omega[b];
     r.vx[b] += h * ctx.body_ax;
     r.vy[b] += h * ctx.body_ay;
   }
@@ -163,7 +164,9 @@ void advance_nscd(Simulation& sim) {
 
   // 4. contact impulses (v^+)
   NscdStepResult solved;
-  if (ctx.contact_on) solved = sim.contact.solve_impulses(model, before, h, {ctx.body_ax, ctx.body_ay}, ctx.nscd_settings);
+  if (ctx.contact_on)
+    solved =
+        sim.contact.solve_impulses(model, before, h, {ctx.body_ax, ctx.body_ay}, ctx.nscd_settings);
   sim.nscd_stats.add(solved);
   clock.stamp(timers.contact);
 

@@ -126,9 +126,10 @@ int command_check(const Config& config, const CommonOptions& common, const Check
                                              : "elastic (constant-strain triangles)");
   if (sim.ctx.nscd) {
     // Non-smooth contact dynamics: no stiffness, no stable limit (docs/nscd.md).
-    std::printf("scheme      nscd: Moreau-Jean theta = %g, rigid contact points, Gauss-Seidel to "
-                "%g (at most %d sweeps a step)\n",
-                config.solver.theta, config.solver.tolerance, config.solver.max_iterations);
+    std::printf(
+        "scheme      nscd: Moreau-Jean theta = %g, rigid contact points, Gauss-Seidel to "
+        "%g (at most %d sweeps a step)\n",
+        config.solver.theta, config.solver.tolerance, config.solver.max_iterations);
     std::printf("dt          %.4g s (set by the %s)\n", info.dt, info.dt_set_by.c_str());
     std::printf("restitution %.3g (%s)\n", sim.contact.params().restitution,
                 config.contact.has("restitution") ? "contact.restitution"

@@ -32,8 +32,7 @@ Simulation deck_sim(const std::string& text, const std::vector<std::string>& set
 }
 
 // A rigid block w x h on a fixed ground (scene "block"), by non-smooth contact dynamics.
-std::string block_deck(double width, double height, double friction,
-                       const std::string& more = "") {
+std::string block_deck(double width, double height, double friction, const std::string& more = "") {
   return "[model]\nkind = \"block\"\nwidth = " + std::to_string(width) +
          "\nheight = " + std::to_string(height) + "\n" + more +
          "[material]\nmodel = \"rigid\"\n[contact]\nfriction = " + std::to_string(friction) +
@@ -110,8 +109,8 @@ TEST(NscdPoints, ACornerInAFaceGivesOnePoint) {
   // A square turned by 45 degrees with its lower corner 0.5 mm into the top face of P.
   const double r = std::sqrt(0.5);
   const Vec2 p[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-  const Vec2 q[4] = {{0.5, 0.9995}, {0.5 + r, 0.9995 + r}, {0.5, 0.9995 + 2 * r},
-                     {0.5 - r, 0.9995 + r}};
+  const Vec2 q[4] = {
+      {0.5, 0.9995}, {0.5 + r, 0.9995 + r}, {0.5, 0.9995 + 2 * r}, {0.5 - r, 0.9995 + r}};
   std::vector<ContactPoint> out;
   piece_contact_points(p, 4, 0xfu, q, 4, 0xfu, 0.01, 0, 1, 0, out);
   ASSERT_EQ(out.size(), 1u);
@@ -156,8 +155,8 @@ double down_slope_speed(const Simulation& sim, double incline_deg) {
   const double th = incline_deg * std::numbers::pi / 180.0;
   const RigidBodies& r = sim.model.rigid;
   // The scene's ground falls towards +x or -x: the speed's magnitude along the slope.
-  return std::abs(r.vx[b] * std::cos(th) + std::abs(r.vy[b]) * std::sin(th) *
-                                               (r.vx[b] >= 0.0 ? 1.0 : -1.0));
+  return std::abs(r.vx[b] * std::cos(th) +
+                  std::abs(r.vy[b]) * std::sin(th) * (r.vx[b] >= 0.0 ? 1.0 : -1.0));
 }
 
 TEST(Nscd, AnInclineHoldsBelowTheFrictionAngleAndSlidesWithCoulombsAcceleration) {
@@ -264,14 +263,14 @@ TEST(NscdProgram, TheArchsCapacityLiesBetweenTheExplicitSchemeAndLimitAnalysis) 
   const std::string json = temp_path("nscd_arch.json");
   const std::string limit_json = temp_path("nscd_arch_limit.json");
   const std::string deck = std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml";
-  const testing::ProcessResult cap = testing::run_process(
-      {VOUSSOIR_BINARY, "capacity", deck, "--set", "solver.scheme=\"nscd\"", "--quiet", "--json",
-       json},
-      {.wall_s = 120, .cpu_s = 240}, temp_path("nscd_arch"));
+  const testing::ProcessResult cap =
+      testing::run_process({VOUSSOIR_BINARY, "capacity", deck, "--set", "solver.scheme=\"nscd\"",
+                            "--quiet", "--json", json},
+                           {.wall_s = 120, .cpu_s = 240}, temp_path("nscd_arch"));
   ASSERT_TRUE(cap.exited && cap.status == 0) << cap.describe() << cap.err;
-  const testing::ProcessResult lim = testing::run_process(
-      {VOUSSOIR_BINARY, "limit", deck, "--quiet", "--json", limit_json}, {.wall_s = 60},
-      temp_path("nscd_arch_limit"));
+  const testing::ProcessResult lim =
+      testing::run_process({VOUSSOIR_BINARY, "limit", deck, "--quiet", "--json", limit_json},
+                           {.wall_s = 60}, temp_path("nscd_arch_limit"));
   ASSERT_TRUE(lim.exited && lim.status == 0) << lim.describe() << lim.err;
   const nlohmann::json c = nlohmann::json::parse(testing::read_text_file(json));
   const nlohmann::json l = nlohmann::json::parse(testing::read_text_file(limit_json));
