@@ -372,8 +372,8 @@ const std::vector<KeySpec>& key_table() {
       {"solver.damping_factor", [](Reader& r, const toml::node& n, Config& c) { c.solver.damping_factor = r.number(n, at_least(0)); }},
       {"solver.end_time", [](Reader& r, const toml::node& n, Config& c) { c.solver.end_time = r.number(n, above(0), "s"); }},
       {"solver.scheme", [](Reader& r, const toml::node& n, Config& c) { c.solver.scheme = r.choice(n, {"explicit", "nscd"}); }},
-      {"solver.theta", [](Reader& r, const toml::node& n, Config& c) { c.solver.theta = r.number(n, {0.5, true, 1, true}); }},
-      {"solver.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.solver.tolerance = r.number(n, above(0), "relative change of the impulses"); }},
+      {"solver.theta", [](Reader& r, const toml::node& n, Config& c) { c.solver.theta = r.number(n, {0.5, false, 1, false}); }},
+      {"solver.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.solver.tolerance = r.number(n, above(0), "x the step's velocity scale"); }},
       {"solver.max_iterations", [](Reader& r, const toml::node& n, Config& c) { c.solver.max_iterations = r.integer(n, 1, 100000000); }},
       // [load]
       {"load.gravity", [](Reader& r, const toml::node& n, Config& c) { c.load.gravity = r.number(n, at_least(0), "m/s2"); }},

@@ -95,7 +95,8 @@ const std::map<std::string, std::string>& meanings() {
        "dynamics, rigid joints (needs material.model = \"rigid\"; docs/nscd.md)"},
       {"solver.theta", "nscd: Moreau-Jean's theta (0.5: no numerical dissipation)"},
       {"solver.tolerance",
-       "nscd: the Gauss-Seidel stops when the impulses change by less than this fraction"},
+       "nscd: the Gauss-Seidel stops when a sweep changes no body's velocity by more than this "
+       "times h |a| or the fastest approach (docs/nscd.md)"},
       {"solver.max_iterations",
        "nscd: most Gauss-Seidel sweeps a step (a step that reaches it is counted unconverged)"},
       // [load]

@@ -305,6 +305,9 @@ TEST(NscdDeck, BadSettingsAreRefusedNamingTheKeyAndValue) {
       EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   }
+  // The ends of theta's range are allowed.
+  for (const char* set : {"solver.theta=0.5", "solver.theta=1", "solver.theta=1.0"})
+    EXPECT_NO_THROW(parse_deck(deck, "test", {set})) << set;
   // Through the program: exit status 2.
   const testing::ProcessResult p = testing::run_process(
       {VOUSSOIR_BINARY, "check", std::string(VOUSSOIR_SOURCE_DIR) + "/cases/circular_arch.toml",
