@@ -1,5 +1,5 @@
 #pragma once
-// Non-smooth contact dynamics of rigid blocks (SPEC section 1, `solver.scheme = "nscd"`;
+// Non-smooth contact dynamics of rigid blocks (`solver.scheme = "nscd"`;
 // docs/nscd.md): contact points between block outlines, Signorini's condition with Newton's
 // impact law and Coulomb friction at each, solved for the step's impulses by non-linear
 // Gauss-Seidel (Moreau, Jean: "Numerical aspects of the sweeping process", CMAME 177 (1999);
@@ -107,7 +107,7 @@ void piece_contact_points(const Vec2* p, int np, std::uint32_t p_outline, const 
                           std::uint32_t q_outline, double alert, Index a, Index b,
                           std::uint64_t key_base, std::vector<ContactPoint>& out);
 
-// The settings of a step (SPEC: solver.theta, solver.tolerance, solver.max_iterations,
+// The settings of a step (docs/reference/deck.md: solver.theta, solver.tolerance, solver.max_iterations,
 // contact.friction, contact.restitution).
 struct NscdSettings {
   double theta = 0.5;

@@ -1,4 +1,4 @@
-// What the program promises at its edges (SPEC.md section 2, exit statuses): the help's
+// What the program promises at its edges (docs/reference/commands.md, exit statuses): the help's
 // defaults are the ones the code uses, and the docs say the same; a deck without gravity is
 // refused by name by every analysis whose loads are multiples of the weight, and run by `run`;
 // options that cannot mean anything (--lambda-star negative or NaN, --thrust with

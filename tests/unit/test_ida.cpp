@@ -366,7 +366,7 @@ TEST(Ida, SlenderBlockUnderThreeRecords) {
     // A record whose peak stays below lambda* g cannot tip the block.
     EXPECT_GE(lo, 0.2);
   }
-  // SPEC section 2's fields.
+  // docs/reference/output.md's fields.
   for (const char* key : {"im", "period", "records", "fragility", "ranks", "wall_s"})
     EXPECT_TRUE(j.contains(key)) << key;
   for (const char* key : {"file", "collapse_im", "bracket", "trials", "wall_s"})

@@ -20,6 +20,7 @@
 #include "drivers/setup.hpp"
 #include "io/checkpoint.hpp"
 #include "io/deck.hpp"
+#include "split_restart.hpp"
 #include "subprocess.hpp"
 
 namespace voussoir {
@@ -214,20 +215,9 @@ TEST(Nscd, ARockingImpactLosesHousnersShare) {
 
 TEST(Nscd, RestartContinuesBitForBit) {
   const std::string deck = block_deck(0.25, 1.0, 0.8);
-  auto tilt = [](Simulation& s) {
-    set_rigid_state(s.model, free_block(s.model), 0.0, 0.51, 0.05, 0.0, 0.0, 0.0);
-  };
-  Simulation straight = deck_sim(deck);
-  tilt(straight);
-  for (int k = 0; k < 400; ++k) advance(straight);
-  Simulation first = deck_sim(deck);
-  tilt(first);
-  for (int k = 0; k < 150; ++k) advance(first);
-  const std::string path = ::testing::TempDir() + "nscd_restart.ckpt";
-  write_checkpoint(path, first, simulation_fingerprint(first, 0.8), 0.8, {});
-  Simulation second = deck_sim(deck);
-  read_checkpoint(path, second, simulation_fingerprint(second, 0.8));
-  for (int k = 0; k < 250; ++k) advance(second);
+  const auto make = [&] { return deck_sim(deck); };
+  const auto [straight, second] = testing::split_restart(
+      make, free_block(make().model), 0.8, ::testing::TempDir() + "nscd_restart.ckpt");
   EXPECT_EQ(second.model.rigid.ux, straight.model.rigid.ux);
   EXPECT_EQ(second.model.rigid.theta, straight.model.rigid.theta);
   EXPECT_EQ(second.model.rigid.omega, straight.model.rigid.omega);
@@ -240,8 +230,8 @@ TEST(Nscd, RestartContinuesBitForBit) {
 
 TEST(Nscd, ABlockUnderLambdaStandsBelowWidthOverHeightAndTipsAbove) {
   // Under lambda g a 0.5 x 1 block holds below its capacity and moves above it: it tips at
-  // lambda = b/h = 0.5 when mu = 0.8, and slides at lambda = mu when mu = 0.3 (SPEC section 3,
-  // "block"). `motion` reads the rotation or the slip.
+  // lambda = b/h = 0.5 when mu = 0.8, and slides at lambda = mu when mu = 0.3 (cases/README.md,
+  // "block.toml"). `motion` reads the rotation or the slip.
   auto moved = [](double mu, double lambda, bool tips) {
     Simulation sim = deck_sim(block_deck(0.5, 1.0, mu));
     set_static_load(sim, kG, lambda);

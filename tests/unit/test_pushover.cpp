@@ -378,7 +378,7 @@ TEST(Pushover, CommandRefusesBadOptionsWithStatusTwo) {
   std::filesystem::remove_all(dir);
 }
 
-// The program's JSON against SPEC's names, towards -x and +x, with its CSV: a 0.25 x 1 m rigid
+// The program's JSON against docs/reference/output.md's names, towards -x and +x, with its CSV: a 0.25 x 1 m rigid
 // block on stiff joints (its rocking curve: peak b/h at d ~ 0, lambda 0 at the corner's
 // tipping point). -x is the mirror of +x: the same curve within 1e-3 b/h. The CSV holds the
 // JSON's curve and its SDOF curve (one block: d* = d, a* = lambda g). --dynamic runs the
@@ -418,7 +418,7 @@ TEST(Pushover, CommandJsonCsvAndDirections) {
   std::filesystem::create_directories(dir);
   std::string csv;
   const nlohmann::json minus = pushover_cli(dir, "minus", {"--direction", "-x"}, &csv);
-  // SPEC section 2's fields.
+  // docs/reference/output.md's fields.
   for (const char* key :
        {"curve", "peak", "ultimate_displacement", "control", "sdof", "hinges", "wall_s"})
     EXPECT_TRUE(minus.contains(key)) << key;

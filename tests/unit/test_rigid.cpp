@@ -20,6 +20,7 @@
 #include "io/checkpoint.hpp"
 #include "io/deck.hpp"
 #include "mesh/minimal.hpp"
+#include "split_restart.hpp"
 
 namespace voussoir {
 namespace {
@@ -178,7 +179,7 @@ TEST(Rigid, DroppedBlockReboundsToRestitutionSquaredOfItsHeight) {
   }
 }
 
-// No tension (SPEC section 1): a block pressed 1e-7 m into its joint and leaving it at 0.1 m/s,
+// No tension (docs/rigid.md, "Impact damping"): a block pressed 1e-7 m into its joint and leaving it at 0.1 m/s,
 // with a strong dashpot (restitution 0.1), gets from the joint a normal force that is never a
 // pull: the dashpot's 1e5 N would pull against the spring's 250 N; it is held to the spring's
 // push, the total zero. Approaching, the dashpot adds to the spring.
@@ -230,21 +231,9 @@ TEST(Rigid, RestartContinuesBitForBit) {
   // A rocking block with impact damping: 400 steps straight, or 150, a checkpoint, a fresh
   // simulation restored from it and 250 more.
   const std::string deck = block_deck("friction = 0.8\nnormal_stiffness = 1e10\nrestitution = 0.3");
-  auto tilt = [](Simulation& s) {
-    const Index b = free_block(s.model);
-    set_rigid_state(s.model, b, 0.0, 0.51, 0.05, 0.0, 0.0, 0.0);
-  };
-  Simulation straight = deck_sim(deck);
-  tilt(straight);
-  for (int k = 0; k < 400; ++k) advance(straight);
-  Simulation first = deck_sim(deck);
-  tilt(first);
-  for (int k = 0; k < 150; ++k) advance(first);
-  const std::string path = ::testing::TempDir() + "rigid_restart.ckpt";
-  write_checkpoint(path, first, simulation_fingerprint(first, 0.8), 0.8, {});
-  Simulation second = deck_sim(deck);
-  read_checkpoint(path, second, simulation_fingerprint(second, 0.8));
-  for (int k = 0; k < 250; ++k) advance(second);
+  const auto make = [&] { return deck_sim(deck); };
+  const auto [straight, second] = testing::split_restart(
+      make, free_block(make().model), 0.8, ::testing::TempDir() + "rigid_restart.ckpt");
   EXPECT_EQ(second.model.nodes.x, straight.model.nodes.x);
   EXPECT_EQ(second.model.nodes.y, straight.model.nodes.y);
   EXPECT_EQ(second.model.rigid.theta, straight.model.rigid.theta);
