@@ -3,7 +3,6 @@
 
 #include "contact/nscd.hpp"
 
-#include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <array>
@@ -16,19 +15,22 @@
 namespace voussoir {
 
 namespace {
-// The direct solve (nscd.hpp "Direct solve"): after this many sweeps without convergence; at
-// most this many passes of status corrections; the compliance that keeps redundant contacts
-// definite, as a fraction of each unknown's own Delassus term; a direct solve is taken when it
-// changes no body's velocity by more than kDirectReach times the tolerance's velocity scale.
-// (church_b's capacity: a compliance of 1e-6 let its trials creep past the time limit, a
-// reach of 2 let solves through that made a stable trial creep to a timeout.)
-constexpr int kSweepsBeforeDirect = 20;
-constexpr int kDirectPasses = 8;
-constexpr double kDirectCompliance = 1e-10;
-constexpr double kDirectReach = 0.5;
-// Unknowns up to which the direct solve's system is dense (an arch's 50; a church's 1000 are
-// sparse).
-constexpr int kDenseDirect = 200;
+// The cone solve (nscd.hpp "Cone solve"): taken after every this many sweeps without
+// convergence; at most this many products with the Delassus operator W in one cone solve, and
+// this many passes of Tresca's box (the sweeps that follow settle the friction); a Newton step on
+// the free face every this many products; the regularisation of the face's matrix (its diagonal is
+// 1), which keeps redundant contacts definite (1e-10 let steps through whose impulses ran off along
+// the redundancy, refused by the descent test one time in four; 1e-3 slowed the steps towards the
+// solution ninefold).
+constexpr int kSweepsBeforeCone = 20;
+constexpr int kConeProducts = 3000;
+constexpr int kTrescaPasses = 2;
+constexpr int kNewtonEvery = 10;
+constexpr double kFaceRegularisation = 1e-6;
+// Power iterations for the largest eigenvalue of W (the projections' step), and its margin
+// (power iterations approach it from below).
+constexpr int kPowerIterations = 8;
+constexpr double kNormMargin = 1.1;
 }  // namespace
 
 PointImpulse solve_point(double wnn, double wnt, double wtt, double qn, double qt, double u_min,
@@ -152,6 +154,7 @@ void piece_contact_points(const Vec2* p, int np, std::uint32_t p_outline, const 
 void NscdStats::add(const NscdStepResult& r) {
   ++steps;
   iterations += r.iterations;
+  if (r.cone_products > 0) ++cone_steps;
   if (!r.converged) ++unconverged_steps;
   max_iterations = std::max(max_iterations, r.iterations);
   max_residual = std::max(max_residual, r.residual);
@@ -254,6 +257,137 @@ inline void local_velocity(const ContactPoint& c, const double* v, double rax, d
   ut = -dx * c.n.y + dy * c.n.x;
 }
 
+// Modified proportioning with reduced gradient projections (MPRGP: Dostal, "Optimal quadratic
+// programming algorithms", Springer 2009, ch. 7 and 8) for min f(y) = y.A y / 2 - b.y over the
+// box lo <= y <= hi, A symmetric positive semi-definite with unit diagonal, applied by
+// apply_a(x, A x). Conjugate gradients on the free face while they stay in the box, an
+// expansion step (to the box, then a projected gradient step of length alpha_bar <= 1/|A|)
+// when they would leave it, a proportioning step that frees the bounds holding the solution
+// back when the chopped gradient outweighs the free one. Every kNewtonEvery products,
+// face_newton(free, g, d) offers d = -A_FF^-1 g_F on the free face F; its projection on the
+// box is taken when it lowers f (else a quarter of it, up to three times).
+// Stops when every component of the projected gradient times `weight` is at most `tol`
+// (`converged`), or after `max_products` products with A. Returns the products used.
+template <class Apply, class FaceNewton>
+int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vector<double>& b,
+           const std::vector<double>& lo, const std::vector<double>& hi,
+           const std::vector<double>& weight, double tol, double alpha_bar, int max_products,
+           std::vector<double>& y, bool& converged) {
+  const std::size_t m = y.size();
+  std::vector<double> g(m), p(m), ap(m), phi(m), beta(m), d(m), y_try(m), g_try(m);
+  std::vector<char> free(m);
+  int products = 0, last_newton = -kNewtonEvery;
+  auto gradient_at = [&](const std::vector<double>& x, std::vector<double>& out) {
+    apply_a(x, out);
+    ++products;
+    for (std::size_t i = 0; i < m; ++i) out[i] -= b[i];
+  };
+  // f from y and its gradient g = A y - b
+  auto objective = [&](const std::vector<double>& x, const std::vector<double>& gx) {
+    double f = 0.0;
+    for (std::size_t i = 0; i < m; ++i) f += 0.5 * x[i] * (gx[i] - b[i]);
+    return f;
+  };
+  // The free gradient phi and the chopped gradient beta; returns the largest weighted
+  // component of the projected gradient phi + beta.
+  auto split = [&]() {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const bool at_lo = y[i] <= lo[i], at_hi = y[i] >= hi[i];
+      phi[i] = at_lo || at_hi ? 0.0 : g[i];
+      beta[i] = at_lo && at_hi ? 0.0
+                : at_lo        ? std::min(g[i], 0.0)
+                : at_hi        ? std::max(g[i], 0.0)
+                               : 0.0;
+      worst = std::max(worst, weight[i] * std::abs(phi[i] + beta[i]));
+    }
+    return worst;
+  };
+  // The longest step along -dir that stays in the box.
+  auto feasible_step = [&](const std::vector<double>& dir) {
+    double a = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < m; ++i) {
+      if (dir[i] > 0.0) a = std::min(a, (y[i] - lo[i]) / dir[i]);
+      if (dir[i] < 0.0) a = std::min(a, (y[i] - hi[i]) / dir[i]);
+    }
+    return a;
+  };
+  for (std::size_t i = 0; i < m; ++i) y[i] = std::clamp(y[i], lo[i], hi[i]);
+  gradient_at(y, g);
+  double worst = split();
+  p = phi;
+  converged = false;
+  while (products < max_products) {
+    if (worst <= tol) {
+      converged = true;
+      break;
+    }
+    if (products - last_newton >= kNewtonEvery) {
+      last_newton = products;
+      for (std::size_t i = 0; i < m; ++i) free[i] = y[i] > lo[i] && y[i] < hi[i];
+      if (face_newton(free, g, d)) {
+        const double f0 = objective(y, g);
+        double scale = 1.0;
+        for (int tries = 0; tries < 4; ++tries, scale *= 0.25) {
+          for (std::size_t i = 0; i < m; ++i)
+            y_try[i] = std::clamp(y[i] + scale * d[i], lo[i], hi[i]);
+          gradient_at(y_try, g_try);
+          if (objective(y_try, g_try) <= f0) {
+            y.swap(y_try), g.swap(g_try);
+            worst = split();
+            p = phi;
+            break;
+          }
+        }
+        continue;
+      }
+    }
+    double beta2 = 0.0, phi_reduced = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      beta2 += beta[i] * beta[i];
+      if (phi[i] == 0.0) continue;
+      const double reduced = phi[i] > 0.0 ? std::min((y[i] - lo[i]) / alpha_bar, phi[i])
+                                          : std::max((y[i] - hi[i]) / alpha_bar, phi[i]);
+      phi_reduced += reduced * phi[i];
+    }
+    if (beta2 <= phi_reduced) {
+      apply_a(p, ap);
+      ++products;
+      double pap = 0.0, gp = 0.0;
+      for (std::size_t i = 0; i < m; ++i) pap += p[i] * ap[i], gp += g[i] * p[i];
+      if (!(pap > 0.0)) break;
+      const double a_cg = gp / pap, a_f = feasible_step(p);
+      if (a_cg <= a_f) {  // conjugate gradient step
+        for (std::size_t i = 0; i < m; ++i) y[i] -= a_cg * p[i], g[i] -= a_cg * ap[i];
+        worst = split();
+        double phi_ap = 0.0;
+        for (std::size_t i = 0; i < m; ++i) phi_ap += phi[i] * ap[i];
+        const double gamma = phi_ap / pap;
+        for (std::size_t i = 0; i < m; ++i) p[i] = phi[i] - gamma * p[i];
+      } else {  // expansion step
+        for (std::size_t i = 0; i < m; ++i) y[i] -= a_f * p[i], g[i] -= a_f * ap[i];
+        split();
+        for (std::size_t i = 0; i < m; ++i)
+          y[i] = std::clamp(y[i] - alpha_bar * phi[i], lo[i], hi[i]);
+        gradient_at(y, g);
+        worst = split();
+        p = phi;
+      }
+    } else {  // proportioning step
+      apply_a(beta, ap);
+      ++products;
+      double dad = 0.0, gd = 0.0;
+      for (std::size_t i = 0; i < m; ++i) dad += beta[i] * ap[i], gd += g[i] * beta[i];
+      if (!(dad > 0.0)) break;
+      const double a = std::min(gd / dad, feasible_step(beta));
+      for (std::size_t i = 0; i < m; ++i) y[i] -= a * beta[i], g[i] -= a * ap[i];
+      worst = split();
+      p = phi;
+    }
+  }
+  return products;
+}
+
 }  // namespace
 
 NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& before, double h,
@@ -321,24 +455,16 @@ NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& befor
       out.converged = true;
       break;
     }
-    // Slow sweeps: the impulses settle along the chains of blocks one block a sweep. The
-    // direct solve puts them in place at once (solve_direct); the sweeps go on from there.
-    if (out.iterations == kSweepsBeforeDirect) {
-      const std::vector<double> rn = rn_, rt = rt_, v_sweeps = v;
-      solve_direct(model, v_free, inv, u_min, mu, v);
-      ++out.direct_solves;
-      // A solve that moves a body by more than a step's worth of the loads is off (statuses
-      // that cycle, redundant contacts asked for different velocities): the sweeps go on
-      // from where they were instead.
-      double moved = 0.0;
-      for (std::size_t b = 0; b < nb; ++b)
-        moved = std::max(
-            moved, std::hypot(v[3 * b] - v_sweeps[3 * b], v[3 * b + 1] - v_sweeps[3 * b + 1]) +
-                       radius_[b] * std::abs(v[3 * b + 2] - v_sweeps[3 * b + 2]));
-      if (!(moved <= kDirectReach * v_scale)) {
-        rn_ = rn, rt_ = rt, v = v_sweeps;
-        --out.direct_solves;
-      }
+    // Slow sweeps: the impulses settle along the chains of blocks one block a sweep. The cone
+    // solve puts them in place (cone_solve); the sweeps go on from there and judge it, and
+    // take it again after as many sweeps.
+    if (out.iterations % kSweepsBeforeCone == 0) {
+      bool cone_converged = false;
+      out.cone_products +=
+          cone_solve(inv, v_free, u_min, mu, settings.tolerance * v_scale, cone_converged);
+      v = v_free;
+      for (std::size_t k = 0; k < n; ++k)
+        if (rn_[k] != 0.0 || rt_[k] != 0.0) apply(k, rn_[k], rt_[k]);
     }
   }
   // The bodies take v^+; the impulses' work over the step (nscd.hpp "Energy").
@@ -369,158 +495,6 @@ NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& befor
   return out;
 }
 
-void NscdContact::solve_direct(const Model& model, const std::vector<double>& v_free,
-                               const std::vector<double>& inv, const std::vector<double>& u_min,
-                               double mu, std::vector<double>& v) {
-  const std::size_t n = points_.size();
-  const std::size_t nb = model.blocks.size();
-  // Status of each point: 0 open, 1 sticking, 2 sliding (r_t = slide_sign mu r_n).
-  std::vector<std::uint8_t> status(n, 0);
-  std::vector<double> sign(n, 0.0);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!(rn_[k] > 0.0)) continue;
-    const bool slides = mu > 0.0 && std::abs(rt_[k]) >= mu * rn_[k] * (1.0 - 1e-9);
-    status[k] = slides ? 2 : 1;
-    sign[k] = rt_[k] >= 0.0 ? 1.0 : -1.0;
-  }
-  // The rows of a point on a body: the body's velocity's effect on U_n (or U_t) of the point.
-  auto row = [&](std::size_t k, bool tangential, bool on_b, double out[3]) {
-    const ContactPoint& c = points_[k];
-    const Vec2 d = tangential ? Vec2{-c.n.y, c.n.x} : c.n;
-    const double rx = on_b ? rb_x_[k] : ra_x_[k], ry = on_b ? rb_y_[k] : ra_y_[k];
-    const double s = on_b ? 1.0 : -1.0;
-    out[0] = s * d.x, out[1] = s * d.y, out[2] = s * (rx * d.y - ry * d.x);
-  };
-  std::vector<double> rn(n), rt(n);
-  for (int pass = 0; pass < kDirectPasses; ++pass) {
-    // Unknowns: r_n of every closed point, r_t of every sticking one; a sliding point's r_t is
-    // its sign times mu times its r_n (a column that is not symmetric: taken from the pass
-    // before, as a given impulse).
-    std::vector<int> col_n(n, -1), col_t(n, -1);
-    int m = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (status[k] == 0) continue;
-      col_n[k] = m++;
-      if (status[k] == 1) col_t[k] = m++;
-    }
-    // The base velocity: free velocities plus the sliding points' friction impulses.
-    std::vector<double> base = v_free;
-    auto push = [&](std::vector<double>& vel, std::size_t k, double pn, double pt) {
-      const ContactPoint& c = points_[k];
-      double j[3];
-      for (const bool on_b : {false, true}) {
-        const std::size_t b = std::size_t(on_b ? c.b : c.a);
-        for (const bool tangential : {false, true}) {
-          const double p = tangential ? pt : pn;
-          if (p == 0.0) continue;
-          row(k, tangential, on_b, j);
-          for (int i = 0; i < 3; ++i) vel[3 * b + i] += inv[3 * b + i] * j[i] * p;
-        }
-      }
-    };
-    for (std::size_t k = 0; k < n; ++k)
-      if (status[k] == 2) push(base, k, 0.0, sign[k] * mu * std::max(rn_[k], 0.0));
-    if (m == 0) break;
-    // A = J M^-1 J^T over the unknowns, by body; b = target - J base.
-    std::vector<std::vector<std::pair<int, std::array<double, 3>>>> by_body(nb);
-    for (std::size_t k = 0; k < n; ++k) {
-      if (status[k] == 0) continue;
-      const ContactPoint& c = points_[k];
-      for (const bool on_b : {false, true}) {
-        const std::size_t b = std::size_t(on_b ? c.b : c.a);
-        if (inv[3 * b] == 0.0) continue;
-        std::array<double, 3> j;
-        row(k, false, on_b, j.data());
-        by_body[b].push_back({col_n[k], j});
-        if (col_t[k] >= 0) {
-          row(k, true, on_b, j.data());
-          by_body[b].push_back({col_t[k], j});
-        }
-      }
-    }
-    // A small compliance keeps A definite where the contacts are redundant (two points on each
-    // joint of a chain of blocks): the impulses of least size among those that give the
-    // velocities, to kDirectCompliance of the velocities. Small systems (an arch) are solved
-    // dense, large ones (a church) sparse.
-    const bool dense = m <= kDenseDirect;
-    Eigen::MatrixXd a_dense;
-    std::vector<Eigen::Triplet<double>> triplets;
-    if (dense) a_dense.setZero(m, m);
-    for (std::size_t b = 0; b < nb; ++b)
-      for (const auto& [i, ji] : by_body[b])
-        for (const auto& [j, jj] : by_body[b]) {
-          const double a = ji[0] * inv[3 * b] * jj[0] + ji[1] * inv[3 * b + 1] * jj[1] +
-                           ji[2] * inv[3 * b + 2] * jj[2];
-          if (dense)
-            a_dense(i, j) += a;
-          else
-            triplets.emplace_back(i, j, a);
-        }
-    Eigen::SparseMatrix<double> a_sparse;
-    if (dense) {
-      for (int i = 0; i < m; ++i) a_dense(i, i) *= 1.0 + kDirectCompliance;
-    } else {
-      a_sparse.resize(m, m);
-      a_sparse.setFromTriplets(triplets.begin(), triplets.end());
-      for (int i = 0; i < m; ++i) a_sparse.coeffRef(i, i) *= 1.0 + kDirectCompliance;
-    }
-    Eigen::VectorXd rhs(m);
-    for (std::size_t k = 0; k < n; ++k) {
-      if (status[k] == 0) continue;
-      double un, ut;
-      local_velocity(points_[k], base.data(), ra_x_[k], ra_y_[k], rb_x_[k], rb_y_[k], un, ut);
-      rhs[col_n[k]] = u_min[k] - un;
-      if (col_t[k] >= 0) rhs[col_t[k]] = -ut;
-    }
-    Eigen::VectorXd x;
-    if (dense) {
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(a_dense);
-      if (ldlt.info() != Eigen::Success) return;  // the sweeps go on from where they were
-      x = ldlt.solve(rhs);
-    } else {
-      const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(a_sparse);
-      if (ldlt.info() != Eigen::Success) return;
-      x = ldlt.solve(rhs);
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-      rn[k] = status[k] == 0 ? 0.0 : x[col_n[k]];
-      rt[k] = status[k] == 1 ? x[col_t[k]] : (status[k] == 2 ? sign[k] * mu * rn_[k] : 0.0);
-    }
-    // The velocities of this solution, then each point's status against its law.
-    std::vector<double> vel = base;
-    for (std::size_t k = 0; k < n; ++k)
-      if (status[k] != 0) push(vel, k, rn[k], status[k] == 1 ? rt[k] : 0.0);
-    bool changed = false;
-    for (std::size_t k = 0; k < n; ++k) {
-      double un, ut;
-      local_velocity(points_[k], vel.data(), ra_x_[k], ra_y_[k], rb_x_[k], rb_y_[k], un, ut);
-      std::uint8_t next = status[k];
-      if (status[k] == 0) {
-        if (un < u_min[k]) next = 1;
-      } else if (!(rn[k] > 0.0)) {
-        next = 0;
-      } else if (status[k] == 1 && mu > 0.0 && std::abs(rt[k]) > mu * rn[k]) {
-        next = 2, sign[k] = rt[k] >= 0.0 ? 1.0 : -1.0;
-      } else if (status[k] == 2 && sign[k] * ut > 0.0) {
-        next = 1;
-      }
-      if (mu == 0.0 && next == 1) next = 2, sign[k] = 1.0;  // no friction: r_t = 0
-      changed = changed || next != status[k];
-      status[k] = next;
-    }
-    // Keep the solution, projected on the laws (r_n >= 0, |r_t| <= mu r_n).
-    for (std::size_t k = 0; k < n; ++k) {
-      rn_[k] = std::max(rn[k], 0.0);
-      rt_[k] = std::clamp(rt[k], -mu * rn_[k], mu * rn_[k]);
-    }
-    if (!changed) break;
-  }
-  // The bodies' velocities from the impulses as they now stand.
-  v = v_free;
-  for (std::size_t k = 0; k < n; ++k)
-    if (rn_[k] != 0.0 || rt_[k] != 0.0) apply_impulse(k, rn_[k], rt_[k], inv, v);
-}
-
 void NscdContact::apply_impulse(std::size_t k, double rn, double rt, const std::vector<double>& inv,
                                 std::vector<double>& v) const {
   const ContactPoint& c = points_[k];
@@ -533,6 +507,193 @@ void NscdContact::apply_impulse(std::size_t k, double rn, double rt, const std::
   vb[2] += ib[2] * (rb_x_[k] * py - rb_y_[k] * px);
   va[0] -= ia[0] * px, va[1] -= ia[1] * py;
   va[2] -= ia[2] * (ra_x_[k] * py - ra_y_[k] * px);
+}
+
+int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<double>& v_free,
+                            const std::vector<double>& u_min, double mu, double tol_v,
+                            bool& converged) {
+  const std::size_t n = points_.size(), m = 2 * n;
+  // Unknowns y = S^-1 (r_n, r_t) point by point, S = diag(W)^-1/2: A = S W S has a unit
+  // diagonal. weight = S^-1 turns a component of A y - b back into a velocity.
+  std::vector<double> s(m), weight(m), b(m), lo(m, 0.0), hi(m), y(m), vel(v_free.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    s[2 * k] = wnn_[k] > 0.0 ? 1.0 / std::sqrt(wnn_[k]) : 0.0;
+    s[2 * k + 1] = wtt_[k] > 0.0 ? 1.0 / std::sqrt(wtt_[k]) : 0.0;
+  }
+  for (std::size_t i = 0; i < m; ++i) weight[i] = s[i] > 0.0 ? 1.0 / s[i] : 0.0;
+  // A x = S H M^-1 H^T S x: x as impulses on bodies at rest, then the points' velocities.
+  auto apply_a = [&](const std::vector<double>& x, std::vector<double>& out) {
+    std::fill(vel.begin(), vel.end(), 0.0);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double pn = s[2 * k] * x[2 * k], pt = s[2 * k + 1] * x[2 * k + 1];
+      if (pn != 0.0 || pt != 0.0) apply_impulse(k, pn, pt, inv, vel);
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      double un, ut;
+      local_velocity(points_[k], vel.data(), ra_x_[k], ra_y_[k], rb_x_[k], rb_y_[k], un, ut);
+      out[2 * k] = s[2 * k] * un, out[2 * k + 1] = s[2 * k + 1] * ut;
+    }
+  };
+  auto face_newton = [&](const std::vector<char>& free, const std::vector<double>& g,
+                         std::vector<double>& d) { return face_step(inv, s, free, g, d); };
+  // b = S (u - H v_free), u = (u_min, 0); the start: the sweeps' impulses.
+  for (std::size_t k = 0; k < n; ++k) {
+    double un, ut;
+    local_velocity(points_[k], v_free.data(), ra_x_[k], ra_y_[k], rb_x_[k], rb_y_[k], un, ut);
+    b[2 * k] = s[2 * k] * (u_min[k] - un);
+    b[2 * k + 1] = -s[2 * k + 1] * ut;
+    y[2 * k] = s[2 * k] > 0.0 ? rn_[k] / s[2 * k] : 0.0;
+    y[2 * k + 1] = s[2 * k + 1] > 0.0 ? rt_[k] / s[2 * k + 1] : 0.0;
+    hi[2 * k] = std::numeric_limits<double>::infinity();
+  }
+  // The projections' step 1 / |A|, |A| by power iterations.
+  double norm_a = 1.0;
+  std::vector<double> x(m, 1.0), ax(m);
+  for (int it = 0; it < kPowerIterations; ++it) {
+    apply_a(x, ax);
+    double ax2 = 0.0, x2 = 0.0;
+    for (std::size_t i = 0; i < m; ++i) ax2 += ax[i] * ax[i], x2 += x[i] * x[i];
+    if (!(ax2 > 0.0)) break;
+    norm_a = std::sqrt(ax2 / x2);
+    const double inv_len = 1.0 / std::sqrt(ax2);
+    for (std::size_t i = 0; i < m; ++i) x[i] = ax[i] * inv_len;
+  }
+  const double alpha_bar = 1.0 / (kNormMargin * norm_a);
+  int products = kPowerIterations;
+  converged = false;
+  for (int pass = 0; pass < kTrescaPasses && products < kConeProducts; ++pass) {
+    // Tresca's box |r_t| <= mu r_n of the last r_n
+    for (std::size_t k = 0; k < n; ++k) {
+      const double c = s[2 * k + 1] > 0.0 ? mu * std::max(rn_[k], 0.0) / s[2 * k + 1] : 0.0;
+      lo[2 * k + 1] = -c, hi[2 * k + 1] = c;
+    }
+    bool box_converged = false;
+    products += box_qp(apply_a, face_newton, b, lo, hi, weight, tol_v, alpha_bar,
+                       kConeProducts - products, y, box_converged);
+    // How far the box would move: mu |dr_n| as a tangential velocity of the point.
+    double shift = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double rn = s[2 * k] * y[2 * k];
+      shift = std::max(shift, mu * std::abs(rn - rn_[k]) * wtt_[k]);
+      rn_[k] = rn, rt_[k] = s[2 * k + 1] * y[2 * k + 1];
+    }
+    if (!box_converged) break;
+    if (shift <= tol_v) {
+      converged = true;
+      break;
+    }
+  }
+  return products;
+}
+
+namespace {
+// What face_step keeps between its calls on a thread: scratch arrays, and the factorisation
+// whose symbolic analysis serves again while the face's pattern stays the same (the same free
+// unknowns on the same bodies). The numbers do not depend on it: a factorisation of the same
+// matrix gives the same values whether its analysis is new or kept.
+struct FaceScratch {
+  std::vector<int> col, body_start, entry_col;
+  std::vector<std::array<double, 3>> entry_row;
+  std::vector<Eigen::Triplet<double>> triplets;
+  std::vector<long long> pattern;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>
+      ldlt;
+  Eigen::SparseMatrix<double> a;
+  Eigen::VectorXd rhs, x;
+  bool analysed = false;
+};
+thread_local FaceScratch t_face;
+}  // namespace
+
+bool NscdContact::face_step(const std::vector<double>& inv, const std::vector<double>& s,
+                            const std::vector<char>& free, const std::vector<double>& g,
+                            std::vector<double>& d) const {
+  FaceScratch& w = t_face;
+  const std::size_t n = points_.size(), m = 2 * n, nb = inv.size() / 3;
+  w.col.assign(m, -1);
+  int f = 0;
+  for (std::size_t i = 0; i < m; ++i)
+    if (free[i] && s[i] > 0.0) w.col[i] = f++;
+  std::fill(d.begin(), d.end(), 0.0);
+  if (f == 0) return false;
+  // The face's pattern: the bodies (movable or not) of each free unknown, in order.
+  std::vector<long long> pattern;
+  pattern.reserve(std::size_t(f) + 1);
+  pattern.push_back(f);
+  for (std::size_t i = 0; i < m; ++i) {
+    if (w.col[i] < 0) continue;
+    const ContactPoint& c = points_[i / 2];
+    const long long a = inv[3 * std::size_t(c.a)] == 0.0 ? -1 : c.a;
+    const long long b = inv[3 * std::size_t(c.b)] == 0.0 ? -1 : c.b;
+    pattern.push_back(((a + 1) << 32) | (b + 1));
+  }
+  // The free unknowns' rows of S H on each movable body (3 entries a body), grouped by body.
+  w.body_start.assign(nb + 1, 0);
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t t = 0; t < 2; ++t) {
+      if (w.col[2 * k + t] < 0) continue;
+      const ContactPoint& c = points_[k];
+      for (const Index body : {c.a, c.b})
+        if (inv[3 * std::size_t(body)] != 0.0) ++w.body_start[std::size_t(body) + 1];
+    }
+  for (std::size_t b = 0; b < nb; ++b) w.body_start[b + 1] += w.body_start[b];
+  w.entry_col.resize(std::size_t(w.body_start[nb]));
+  w.entry_row.resize(std::size_t(w.body_start[nb]));
+  std::vector<int> fill(w.body_start.begin(), w.body_start.end() - 1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const ContactPoint& c = points_[k];
+    for (std::size_t t = 0; t < 2; ++t) {
+      const std::size_t i = 2 * k + t;
+      if (w.col[i] < 0) continue;
+      const Vec2 dir = t ? Vec2{-c.n.y, c.n.x} : c.n;
+      for (const bool on_b : {false, true}) {
+        const std::size_t body = std::size_t(on_b ? c.b : c.a);
+        if (inv[3 * body] == 0.0) continue;
+        const double rx = on_b ? rb_x_[k] : ra_x_[k], ry = on_b ? rb_y_[k] : ra_y_[k];
+        const double sign = (on_b ? 1.0 : -1.0) * s[i];
+        const std::size_t e = std::size_t(fill[body]++);
+        w.entry_col[e] = w.col[i];
+        w.entry_row[e] = {sign * dir.x, sign * dir.y, sign * (rx * dir.y - ry * dir.x)};
+      }
+    }
+  }
+  // A_FF = sum over the bodies of row_i M^-1 row_j (lower triangle), plus the regularisation.
+  w.triplets.clear();
+  for (std::size_t body = 0; body < nb; ++body) {
+    const double* ib = &inv[3 * body];
+    for (int e = w.body_start[body]; e < w.body_start[body + 1]; ++e)
+      for (int o = w.body_start[body]; o < w.body_start[body + 1]; ++o) {
+        const int i = w.entry_col[std::size_t(e)], j = w.entry_col[std::size_t(o)];
+        if (i < j) continue;
+        const auto& ri = w.entry_row[std::size_t(e)];
+        const auto& rj = w.entry_row[std::size_t(o)];
+        w.triplets.emplace_back(
+            i, j, ri[0] * ib[0] * rj[0] + ri[1] * ib[1] * rj[1] + ri[2] * ib[2] * rj[2]);
+      }
+  }
+  for (int i = 0; i < f; ++i) w.triplets.emplace_back(i, i, kFaceRegularisation);
+  w.a.resize(f, f);
+  w.a.setFromTriplets(w.triplets.begin(), w.triplets.end());
+  // The points come in the order of the detection, which follows the blocks along the
+  // structure: the natural order keeps the fill small (an approximate minimum degree ordering
+  // cost more than it saved).
+  if (!w.analysed || pattern != w.pattern) {
+    w.ldlt.analyzePattern(w.a);
+    w.pattern.swap(pattern);
+    w.analysed = true;
+  }
+  w.ldlt.factorize(w.a);
+  if (w.ldlt.info() != Eigen::Success) {
+    w.analysed = false;
+    return false;
+  }
+  w.rhs.resize(f);
+  for (std::size_t i = 0; i < m; ++i)
+    if (w.col[i] >= 0) w.rhs[w.col[i]] = -g[i];
+  w.x = w.ldlt.solve(w.rhs);
+  for (std::size_t i = 0; i < m; ++i)
+    if (w.col[i] >= 0) d[i] = w.x[w.col[i]];
+  return true;
 }
 
 std::vector<BlockPairForce> NscdContact::pair_forces(const Model& model, double h) const {

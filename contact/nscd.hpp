@@ -45,21 +45,24 @@
 // The order is the points' order, fixed by the detection: the result does not depend on the
 // thread count (the solve runs on one thread).
 //
-// Direct solve. Gauss-Seidel carries a change of load along a chain of blocks one block a
+// Cone solve. Gauss-Seidel carries a change of load along a chain of blocks one block a
 // sweep, and settles it in about N^2 sweeps for N blocks: the thrust of an arch of 2-degree
-// voussoirs (church_b's) was still wrong after 1000 sweeps. When the sweeps have not
-// converged after kSweepsBeforeDirect, the impulses of the points are solved at once: each
-// point's status is read from the sweeps (open: r = 0; sticking: U = (u_min, 0); sliding:
-// U_n = u_min with r_t = s mu r_n, s the side it slides to), the sparse linear system
-// A x = b with A = J M^-1 J^T over the unknowns (the closed points' r_n, the sticking points'
-// r_t; a sliding point's r_t taken from before, which keeps A symmetric) is factored
-// (Eigen's SimplicialLDLT), and the points whose solution breaks their law change status (a
-// pulling point opens, a penetrating one closes, a sticking one beyond the cone slides, a
-// sliding one whose slip turns sticks) for the next pass. The solution, projected on the laws,
-// is where the sweeps go on from. Two points on every joint make the contacts redundant (more
-// normal unknowns than the bodies have freedoms): a compliance of kDirectCompliance of each
-// unknown's own term keeps A definite and picks the least impulses among those that give the
-// same velocities. The sweeps still decide convergence, on the same tolerance.
+// voussoirs (church_b's) was still wrong after 1000 sweeps. When the sweeps have not converged
+// after kSweepsBeforeCone, the step's impulses are found at once as the minimum of a quadratic
+// program over all points (cone_solve): Coulomb's law at given normal impulses is Tresca's,
+// |r_t| <= mu r_n with r_n fixed, and then the impulses minimise
+//     f(r) = r.W r / 2 + r.(q - u),   u = (u_min, 0) point by point,
+// over the box r_n >= 0, |r_t| <= mu r_n (f's gradient W r + q - u = U - u: its KKT conditions
+// are Signorini's with Newton's u_min and Tresca's law). The box is solved by MPRGP (conjugate
+// gradients on the free face with projections: their products grow like N along a chain where
+// the sweeps grow like N^2), in variables scaled by the Delassus diagonal, with a Newton step
+// on the free face (a sparse LDL^T of W_FF) every few products, kept when it lowers f. Then
+// mu r_n gives the next box, for at most kTrescaPasses boxes. W is applied as H M^-1 H^T,
+// never assembled but on the free face. Two points on every joint make the contacts redundant
+// (W singular): with restitution 0 the gaps' u_min <= 0 keep f bounded below (with a
+// restitution, the cap on the products bounds the solve), and the face's matrix takes a small
+// regularisation. The solution is where the sweeps go on from; they decide convergence, on the
+// same tolerance, and take the cone solve again after every kSweepsBeforeCone sweeps.
 //
 // Energy (the ledger's terms, booked from the impulses, never as a remainder). Over a step the
 // bodies' kinetic energy changes by (h F + P) . (v^- + v^+) / 2 (P: the contact impulses on the
@@ -107,8 +110,8 @@ void piece_contact_points(const Vec2* p, int np, std::uint32_t p_outline, const 
                           std::uint32_t q_outline, double alert, Index a, Index b,
                           std::uint64_t key_base, std::vector<ContactPoint>& out);
 
-// The settings of a step (docs/reference/deck.md: solver.theta, solver.tolerance, solver.max_iterations,
-// contact.friction, contact.restitution).
+// The settings of a step (docs/reference/deck.md: solver.theta, solver.tolerance,
+// solver.max_iterations, contact.friction, contact.restitution).
 struct NscdSettings {
   double theta = 0.5;
   double tolerance = 1e-6;
@@ -120,7 +123,7 @@ struct NscdSettings {
 // What one step's solve gives.
 struct NscdStepResult {
   int iterations = 0;
-  int direct_solves = 0;  // steps whose sweeps took the direct solve (0 or 1)
+  int cone_products = 0;  // products with W of the step's cone solves (0: none)
   bool converged = true;
   double residual = 0.0;     // the last sweep's relative change of the impulses
   double penetration = 0.0;  // largest overlap -g of a point at the start of the step [m]
@@ -137,6 +140,7 @@ struct NscdStats {
   long long steps = 0;
   long long unconverged_steps = 0;  // steps that stopped at max_iterations
   long long iterations = 0;         // summed over the steps
+  long long cone_steps = 0;         // steps that took the cone solve
   int max_iterations = 0;           // largest iteration count of a step
   double max_residual = 0.0;        // largest final residual of a step
   double max_penetration = 0.0;     // largest overlap of a contact point seen [m]
@@ -171,13 +175,17 @@ class NscdContact {
 
  private:
   double alert_ = 0.0;
-  // The direct solve of the sweeps that converge slowly (header "Direct solve"): the impulses
-  // of the closed points from one sparse linear system with each point's status (open,
-  // sticking, sliding) taken from the sweeps, the statuses corrected and the system solved
-  // again, at most kDirectPasses times. `v_free`: the free velocities; `v` takes the result.
-  void solve_direct(const Model& model, const std::vector<double>& v_free,
-                    const std::vector<double>& inv, const std::vector<double>& u_min, double mu,
-                    std::vector<double>& v);
+  // The cone solve of the sweeps that converge slowly (header "Cone solve") from the impulses
+  // rn_, rt_ as they stand; they take the solution. `inv`: inverse masses, `v_free`: the free
+  // velocities, `tol_v`: the largest violation of a point's law left [m/s]. Returns the products
+  // with W used; `converged` when the box and Tresca's passes met tol_v.
+  int cone_solve(const std::vector<double>& inv, const std::vector<double>& v_free,
+                 const std::vector<double>& u_min, double mu, double tol_v, bool& converged);
+  // The Newton step d = -A_FF^-1 g_F of the cone solve on its free face (free[i]; the scaled
+  // unknowns' scales s); false when the face is empty or its matrix does not factor.
+  bool face_step(const std::vector<double>& inv, const std::vector<double>& s,
+                 const std::vector<char>& free, const std::vector<double>& g,
+                 std::vector<double>& d) const;
 
   // Adds the impulse (rn, rt) of point k to its bodies' velocities v (inverse masses inv; 3 a
   // block each).

@@ -19,6 +19,7 @@ void note_solver_runs(const NscdStats& end, const NscdStats& start) {
   g_record.steps += end.steps - start.steps;
   g_record.unconverged_steps += end.unconverged_steps - start.unconverged_steps;
   g_record.iterations += end.iterations - start.iterations;
+  g_record.cone_steps += end.cone_steps - start.cone_steps;
   // The run's largest values: those of the whole simulation, whose history before this run
   // (a copied settled state) is part of the command's record anyway.
   g_record.max_iterations = std::max(g_record.max_iterations, end.max_iterations);
@@ -46,6 +47,7 @@ nlohmann::json solver_json(const Config& config, const NscdStats& r) {
           {"steps", r.steps},
           {"iterations_mean", r.steps > 0 ? double(r.iterations) / double(r.steps) : 0.0},
           {"iterations_max", r.max_iterations},
+          {"cone_steps", r.cone_steps},
           {"unconverged_steps", r.unconverged_steps},
           {"unconverged_share", share},
           {"max_residual", r.max_residual},

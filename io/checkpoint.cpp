@@ -175,7 +175,7 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
     const NscdStats& st = sim.nscd_stats;
     o.array(std::vector<double>{double(st.steps), double(st.unconverged_steps),
                                 double(st.iterations), double(st.max_iterations),
-                                st.max_residual, st.max_penetration});
+                                st.max_residual, st.max_penetration, double(st.cone_steps)});
   }
   o.array(driver_state);
   Fnv sum;
@@ -239,7 +239,8 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   std::vector<double> nscd_stats;
   if (sim.ctx.nscd) {
     nscd_stats = in.array<double>();
-    if (nscd_stats.size() != 6) in.fail("the non-smooth contact solver's record is not readable");
+    // 7 entries; 6 from a build that had no cone solve
+    if (nscd_stats.size() != 7 && nscd_stats.size() != 6) in.fail("the non-smooth contact solver's record is not readable");
   }
   std::vector<double> driver = in.array<double>();
   if (in.pos + sizeof(std::uint64_t) != buf.size()) in.fail("unexpected data after the state");
@@ -281,6 +282,7 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     st.steps = (long long)nscd_stats[0], st.unconverged_steps = (long long)nscd_stats[1];
     st.iterations = (long long)nscd_stats[2], st.max_iterations = int(nscd_stats[3]);
     st.max_residual = nscd_stats[4], st.max_penetration = nscd_stats[5];
+    st.cone_steps = nscd_stats.size() > 6 ? (long long)nscd_stats[6] : 0;
   }
   try {
     sim.contact.restore_state(sim.model, contact);
