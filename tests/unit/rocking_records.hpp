@@ -61,9 +61,13 @@ inline HousnerBlock rocking_block() {
 }
 
 // The deck of the block under `record_path` scaled to a PGA of `amplitude` g (0: as written),
-// joints of normal stiffness `kn` [N/m3].
+// joints of normal stiffness `kn` [N/m3], stepped by `scheme` (solver.scheme; "nscd": rigid
+// contacts, kn does not apply).
 inline std::string rocking_deck(const std::string& record_path, double amplitude,
-                                const std::string& kn = "1e12") {
+                                const std::string& kn = "1e12",
+                                const std::string& scheme = "explicit") {
+  if (scheme != "explicit")
+    return rocking_deck(record_path, amplitude, kn) + "[solver]\nscheme = \"" + scheme + "\"\n";
   char deck[1024];
   std::snprintf(deck, sizeof deck,
                 "[model]\nkind = \"block\"\nwidth = %g\nheight = %g\n"
@@ -189,8 +193,9 @@ inline bool dense_robust(const RecordStudy& st, double scale, double r, bool fel
 // its settled place while the block is within alpha of upright, sampled every millisecond (a
 // block that rocks about corners that do not slide keeps it at the joint's compliance).
 inline PulseResult run_rocking(const SettledState& settled, const RecordStudy& st, double scale,
-                               const std::string& kn = "1e12", double* max_slip = nullptr) {
-  const Config config = parse_deck(rocking_deck(st.path, scale, kn), "rocking");
+                               const std::string& kn = "1e12", double* max_slip = nullptr,
+                               const std::string& scheme = "explicit") {
+  const Config config = parse_deck(rocking_deck(st.path, scale, kn, scheme), "rocking");
   const BaseSignal signal = make_base_signal(config.load.base, config.load.gravity);
   EXPECT_NEAR(signal.peak_acceleration(), scale * config.load.gravity, 1e-9 * config.load.gravity);
   const PulseCriteria crit;

@@ -11,7 +11,9 @@
 // measured on voussoir's joints (0.946), not Housner's 0.912, and its outcomes are checked
 // converged in its step. The chaos figures (the share of scales whose outcome 5% of the scale
 // or 0.01 of r flips, the changes of outcome along the transition band) are printed, not
-// asserted. tests/slow/test_rocking_records_slow.cpp runs every scale of the scan.
+// asserted. The same with the block stepped by non-smooth contact dynamics (solver.scheme =
+// "nscd"), its reference at the impact ratio measured on it. tests/slow/
+// test_rocking_records_slow.cpp runs every scale of the scan.
 
 #include <gtest/gtest.h>
 
@@ -40,17 +42,20 @@ std::vector<std::size_t> robust_scales(const RecordStudy& st, bool fell) {
   return out;
 }
 
-TEST(RockingRecords, SlenderBlockMatchesHousnerWhereHisOutcomeIsRobust) {
+// The scheme's block against the reference at the dense-robust scales (header).
+// `falls_on_every_record`: kPerOutcome dense-robust falls asked of each record, else of the
+// three together.
+void check_against_housner(const std::string& scheme, bool falls_on_every_record) {
   const auto wall0 = std::chrono::steady_clock::now();
   std::vector<RecordStudy> studies = rocking_records(::testing::TempDir());
-  const std::string deck0 = rocking_deck(studies[0].path, 0.0);
+  const std::string deck0 = rocking_deck(studies[0].path, 0.0, "1e12", scheme);
 
   // The impact ratio of these joints, used by the reference.
   const double r = measured_restitution(deck0, 0.5);
   std::printf(
-      "[rocking] impact ratio of voussoir's joints (kn 1e12, restitution 0) %.4f "
+      "[rocking] %s: impact ratio of voussoir's joints (kn 1e12, restitution 0) %.4f "
       "(from alpha / 2), %.4f (from alpha / 8); Housner's %.4f\n",
-      r, measured_restitution(deck0, 0.125), rocking_block().housner_restitution());
+      scheme.c_str(), r, measured_restitution(deck0, 0.125), rocking_block().housner_restitution());
   ASSERT_GT(r, 0.9);
   ASSERT_LT(r, 0.99);
 
@@ -80,7 +85,7 @@ TEST(RockingRecords, SlenderBlockMatchesHousnerWhereHisOutcomeIsRobust) {
   const SettledState settled = settle(parse_deck(deck0, "rocking"), crit.settle, true);
   ASSERT_TRUE(settled.settled);
   double run_wall = 0.0;
-  int runs = 0, agree = 0;
+  int runs = 0, agree = 0, falls_found = 0;
   for (RecordStudy& st : studies)
     for (const bool fell : {false, true}) {
       // The first kPerOutcome robust scales from the threshold that pass dense_robust.
@@ -91,7 +96,7 @@ TEST(RockingRecords, SlenderBlockMatchesHousnerWhereHisOutcomeIsRobust) {
         x.dense = dense_robust(st, x.scale, r, fell);
         if (!x.dense) continue;
         ++found;
-        x.run = run_rocking(settled, st, x.scale, "1e12", &x.max_slip);
+        x.run = run_rocking(settled, st, x.scale, "1e12", &x.max_slip, scheme);
         x.ran = true;
         run_wall += x.run.wall_s;
         ++runs, agree += x.run.collapsed == fell;
@@ -101,9 +106,12 @@ TEST(RockingRecords, SlenderBlockMatchesHousnerWhereHisOutcomeIsRobust) {
             << " (largest rotation " << x.run.max_rotation << " rad)";
         EXPECT_LT(x.run.max_energy_balance_error, 0.01) << st.spec.name << " at " << x.scale;
       }
-      EXPECT_EQ(found, kPerOutcome)
-          << st.spec.name << ": dense-robust " << (fell ? "falls" : "survivals");
+      if (fell) falls_found += found;
+      if (!fell || falls_on_every_record)
+        EXPECT_EQ(found, kPerOutcome)
+            << st.spec.name << ": dense-robust " << (fell ? "falls" : "survivals");
     }
+  EXPECT_GE(falls_found, kPerOutcome);
 
   std::printf(
       "[rocking] scan %.2f to %.2f g in steps of %.0f%%; S / F robust survival / fall, "
@@ -112,10 +120,23 @@ TEST(RockingRecords, SlenderBlockMatchesHousnerWhereHisOutcomeIsRobust) {
   for (const RecordStudy& st : studies) print_chaos(st, r);
   print_runs(studies);
   std::printf(
-      "[rocking] voussoir agrees at %d of %d dense-robust scales; reference scans %.1f s, "
+      "[rocking] %s: voussoir agrees at %d of %d dense-robust scales; reference scans %.1f s, "
       "voussoir runs %.1f s, in all %.1f s of wall\n",
-      agree, runs, ref_wall, run_wall,
+      scheme.c_str(), agree, runs, ref_wall, run_wall,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
+}
+
+TEST(RockingRecords, SlenderBlockMatchesHousnerWhereHisOutcomeIsRobust) {
+  check_against_housner("explicit", true);
+}
+
+// Rigid contacts by non-smooth contact dynamics: the impact ratio is the theta-method's
+// (Housner's within 2%, Nscd.ARockingImpactLosesHousnersShare), measured the same way. At that
+// ratio (0.91 against the explicit joints' 0.945) the reference's falls are dense-robust at
+// fewer scales of the scan: one on R2, none on R3; the falls are asked of the three records
+// together.
+TEST(RockingRecords, NonSmoothContactDynamicsMatchesHousnerWhereHisOutcomeIsRobust) {
+  check_against_housner("nscd", false);
 }
 
 }  // namespace
