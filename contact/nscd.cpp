@@ -459,9 +459,7 @@ NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& befor
     // solve puts them in place (cone_solve); the sweeps go on from there and judge it, and
     // take it again after as many sweeps.
     if (out.iterations % kSweepsBeforeCone == 0) {
-      bool cone_converged = false;
-      out.cone_products +=
-          cone_solve(inv, v_free, u_min, mu, settings.tolerance * v_scale, cone_converged);
+      out.cone_products += cone_solve(inv, v_free, u_min, mu, settings.tolerance * v_scale);
       v = v_free;
       for (std::size_t k = 0; k < n; ++k)
         if (rn_[k] != 0.0 || rt_[k] != 0.0) apply(k, rn_[k], rt_[k]);
@@ -510,8 +508,7 @@ void NscdContact::apply_impulse(std::size_t k, double rn, double rt, const std::
 }
 
 int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<double>& v_free,
-                            const std::vector<double>& u_min, double mu, double tol_v,
-                            bool& converged) {
+                            const std::vector<double>& u_min, double mu, double tol_v) {
   const std::size_t n = points_.size(), m = 2 * n;
   // Unknowns y = S^-1 (r_n, r_t) point by point, S = diag(W)^-1/2: A = S W S has a unit
   // diagonal. weight = S^-1 turns a component of A y - b back into a velocity.
@@ -560,7 +557,6 @@ int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<do
   }
   const double alpha_bar = 1.0 / (kNormMargin * norm_a);
   int products = kPowerIterations;
-  converged = false;
   for (int pass = 0; pass < kTrescaPasses && products < kConeProducts; ++pass) {
     // Tresca's box |r_t| <= mu r_n of the last r_n
     for (std::size_t k = 0; k < n; ++k) {
@@ -577,11 +573,7 @@ int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<do
       shift = std::max(shift, mu * std::abs(rn - rn_[k]) * wtt_[k]);
       rn_[k] = rn, rt_[k] = s[2 * k + 1] * y[2 * k + 1];
     }
-    if (!box_converged) break;
-    if (shift <= tol_v) {
-      converged = true;
-      break;
-    }
+    if (!box_converged || shift <= tol_v) break;
   }
   return products;
 }

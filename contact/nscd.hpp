@@ -178,9 +178,9 @@ class NscdContact {
   // The cone solve of the sweeps that converge slowly (header "Cone solve") from the impulses
   // rn_, rt_ as they stand; they take the solution. `inv`: inverse masses, `v_free`: the free
   // velocities, `tol_v`: the largest violation of a point's law left [m/s]. Returns the products
-  // with W used; `converged` when the box and Tresca's passes met tol_v.
+  // with W used (the sweeps after it judge its convergence).
   int cone_solve(const std::vector<double>& inv, const std::vector<double>& v_free,
-                 const std::vector<double>& u_min, double mu, double tol_v, bool& converged);
+                 const std::vector<double>& u_min, double mu, double tol_v);
   // The Newton step d = -A_FF^-1 g_F of the cone solve on its free face (free[i]; the scaled
   // unknowns' scales s); false when the face is empty or its matrix does not factor.
   bool face_step(const std::vector<double>& inv, const std::vector<double>& s,

@@ -107,9 +107,10 @@ void check_against_housner(const std::string& scheme, bool falls_on_every_record
         EXPECT_LT(x.run.max_energy_balance_error, 0.01) << st.spec.name << " at " << x.scale;
       }
       if (fell) falls_found += found;
-      if (!fell || falls_on_every_record)
+      if (!fell || falls_on_every_record) {
         EXPECT_EQ(found, kPerOutcome)
             << st.spec.name << ": dense-robust " << (fell ? "falls" : "survivals");
+      }
     }
   EXPECT_GE(falls_found, kPerOutcome);
 
