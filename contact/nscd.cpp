@@ -261,18 +261,18 @@ inline void local_velocity(const ContactPoint& c, const double* v, double rax, d
 // programming algorithms", Springer 2009, ch. 7 and 8) for min f(y) = y.A y / 2 - b.y over the
 // box lo <= y <= hi, A symmetric positive semi-definite with unit diagonal, applied by
 // apply_a(x, A x). Conjugate gradients on the free face while they stay in the box, an
-// expansion step (to the box, then a projected gradient step of length alpha_bar <= 1/|A|)
+// expansion step (to the box, then a projected gradient step of length step_length() <= 1/|A|)
 // when they would leave it, a proportioning step that frees the bounds holding the solution
 // back when the chopped gradient outweighs the free one. Every kNewtonEvery products,
 // face_newton(free, g, d) offers d = -A_FF^-1 g_F on the free face F; its projection on the
 // box is taken when it lowers f (else a quarter of it, up to three times).
 // Stops when every component of the projected gradient times `weight` is at most `tol`
 // (`converged`), or after `max_products` products with A. Returns the products used.
-template <class Apply, class FaceNewton>
+template <class Apply, class FaceNewton, class StepLength>
 int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vector<double>& b,
            const std::vector<double>& lo, const std::vector<double>& hi,
-           const std::vector<double>& weight, double tol, double alpha_bar, int max_products,
-           std::vector<double>& y, bool& converged) {
+           const std::vector<double>& weight, double tol, const StepLength& step_length,
+           int max_products, std::vector<double>& y, bool& converged) {
   const std::size_t m = y.size();
   std::vector<double> g(m), p(m), ap(m), phi(m), beta(m), d(m), y_try(m), g_try(m);
   std::vector<char> free(m);
@@ -342,6 +342,7 @@ int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vecto
         continue;
       }
     }
+    const double alpha_bar = step_length();
     double beta2 = 0.0, phi_reduced = 0.0;
     for (std::size_t i = 0; i < m; ++i) {
       beta2 += beta[i] * beta[i];
@@ -531,8 +532,9 @@ int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<do
       out[2 * k] = s[2 * k] * un, out[2 * k + 1] = s[2 * k + 1] * ut;
     }
   };
+  assemble_cone_matrix(inv, s);
   auto face_newton = [&](const std::vector<char>& free, const std::vector<double>& g,
-                         std::vector<double>& d) { return face_step(inv, s, free, g, d); };
+                         std::vector<double>& d) { return face_step(s, free, g, d); };
   // b = S (u - H v_free), u = (u_min, 0); the start: the sweeps' impulses.
   for (std::size_t k = 0; k < n; ++k) {
     double un, ut;
@@ -543,20 +545,27 @@ int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<do
     y[2 * k + 1] = s[2 * k + 1] > 0.0 ? rt_[k] / s[2 * k + 1] : 0.0;
     hi[2 * k] = std::numeric_limits<double>::infinity();
   }
-  // The projections' step 1 / |A|, |A| by power iterations.
-  double norm_a = 1.0;
-  std::vector<double> x(m, 1.0), ax(m);
-  for (int it = 0; it < kPowerIterations; ++it) {
-    apply_a(x, ax);
-    double ax2 = 0.0, x2 = 0.0;
-    for (std::size_t i = 0; i < m; ++i) ax2 += ax[i] * ax[i], x2 += x[i] * x[i];
-    if (!(ax2 > 0.0)) break;
-    norm_a = std::sqrt(ax2 / x2);
-    const double inv_len = 1.0 / std::sqrt(ax2);
-    for (std::size_t i = 0; i < m; ++i) x[i] = ax[i] * inv_len;
-  }
-  const double alpha_bar = 1.0 / (kNormMargin * norm_a);
-  int products = kPowerIterations;
+  // The projections' step 1 / |A|, |A| by power iterations, when a step first needs it (a
+  // solve that the Newton steps finish never does).
+  int products = 0;
+  double alpha_bar = 0.0;
+  auto step_length = [&]() {
+    if (alpha_bar > 0.0) return alpha_bar;
+    double norm_a = 1.0;
+    std::vector<double> x(m, 1.0), ax(m);
+    for (int it = 0; it < kPowerIterations; ++it) {
+      apply_a(x, ax);
+      double ax2 = 0.0, x2 = 0.0;
+      for (std::size_t i = 0; i < m; ++i) ax2 += ax[i] * ax[i], x2 += x[i] * x[i];
+      if (!(ax2 > 0.0)) break;
+      norm_a = std::sqrt(ax2 / x2);
+      const double inv_len = 1.0 / std::sqrt(ax2);
+      for (std::size_t i = 0; i < m; ++i) x[i] = ax[i] * inv_len;
+    }
+    products += kPowerIterations;
+    alpha_bar = 1.0 / (kNormMargin * norm_a);
+    return alpha_bar;
+  };
   for (int pass = 0; pass < kTrescaPasses && products < kConeProducts; ++pass) {
     // Tresca's box |r_t| <= mu r_n of the last r_n
     for (std::size_t k = 0; k < n; ++k) {
@@ -564,7 +573,7 @@ int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<do
       lo[2 * k + 1] = -c, hi[2 * k + 1] = c;
     }
     bool box_converged = false;
-    products += box_qp(apply_a, face_newton, b, lo, hi, weight, tol_v, alpha_bar,
+    products += box_qp(apply_a, face_newton, b, lo, hi, weight, tol_v, step_length,
                        kConeProducts - products, y, box_converged);
     // How far the box would move: mu |dr_n| as a tangential velocity of the point.
     double shift = 0.0;
@@ -579,112 +588,158 @@ int NscdContact::cone_solve(const std::vector<double>& inv, const std::vector<do
 }
 
 namespace {
-// What face_step keeps between its calls on a thread: scratch arrays, and the factorisation
-// whose symbolic analysis serves again while the face's pattern stays the same (the same free
-// unknowns on the same bodies). The numbers do not depend on it: a factorisation of the same
-// matrix gives the same values whether its analysis is new or kept.
+// The face's matrix: the upper triangle of A over all the cone solve's unknowns, column by
+// column, indexed by Eigen::Index: the form the factorisation works on in the natural order
+// without copying it.
+using FaceMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, Eigen::Index>;
+
+// What the cone solve keeps on a thread between its calls: the structure of A (which unknowns
+// share a body), found again only when the points' bodies change, with the symbolic analysis
+// of its factorisation; A's values, assembled once per cone solve; scratch arrays. The numbers
+// do not depend on what is kept: the same matrix factors to the same values whether its
+// structure and analysis are new or kept.
 struct FaceScratch {
-  std::vector<int> col, body_start, entry_col;
-  std::vector<std::array<double, 3>> entry_row;
-  std::vector<Eigen::Triplet<double>> triplets;
-  std::vector<long long> pattern;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>
-      ldlt;
-  Eigen::SparseMatrix<double> a;
+  std::vector<long long> key;   // per point: its two bodies (0: fixed), the structure's key
+  std::vector<int> body_start;  // per body: its entries (below), grouped by body
+  std::vector<Eigen::Index> entry_unknown;       // an entry: an unknown acting on the body...
+  std::vector<std::array<double, 3>> entry_row;  // ...and its row of S H on the body
+  std::vector<Eigen::Index> pair_position;       // per pair of a body's entries: where it adds in A
+  FaceMatrix a;                                  // the face's matrix (A masked to the face)
+  std::vector<double> values;                    // A's values, a's positions
+  Eigen::SimplicialLDLT<FaceMatrix, Eigen::Upper, Eigen::NaturalOrdering<Eigen::Index>> ldlt;
   Eigen::VectorXd rhs, x;
   bool analysed = false;
 };
 thread_local FaceScratch t_face;
+
+// The entries of the bodies (unknowns in order, grouped by body; fixed bodies have none).
+template <class Entry>
+void for_each_entry(const std::vector<ContactPoint>& points, const std::vector<double>& inv,
+                    const Entry& entry) {
+  for (std::size_t k = 0; k < points.size(); ++k)
+    for (std::size_t t = 0; t < 2; ++t)
+      for (const bool on_b : {false, true}) {
+        const std::size_t body = std::size_t(on_b ? points[k].b : points[k].a);
+        if (inv[3 * body] != 0.0) entry(k, t, on_b, body);
+      }
+}
 }  // namespace
 
-bool NscdContact::face_step(const std::vector<double>& inv, const std::vector<double>& s,
-                            const std::vector<char>& free, const std::vector<double>& g,
-                            std::vector<double>& d) const {
+void NscdContact::assemble_cone_matrix(const std::vector<double>& inv,
+                                       const std::vector<double>& s) const {
   FaceScratch& w = t_face;
   const std::size_t n = points_.size(), m = 2 * n, nb = inv.size() / 3;
-  w.col.assign(m, -1);
-  int f = 0;
-  for (std::size_t i = 0; i < m; ++i)
-    if (free[i] && s[i] > 0.0) w.col[i] = f++;
-  std::fill(d.begin(), d.end(), 0.0);
-  if (f == 0) return false;
-  // The face's pattern: the bodies (movable or not) of each free unknown, in order.
-  std::vector<long long> pattern;
-  pattern.reserve(std::size_t(f) + 1);
-  pattern.push_back(f);
-  for (std::size_t i = 0; i < m; ++i) {
-    if (w.col[i] < 0) continue;
-    const ContactPoint& c = points_[i / 2];
-    const long long a = inv[3 * std::size_t(c.a)] == 0.0 ? -1 : c.a;
-    const long long b = inv[3 * std::size_t(c.b)] == 0.0 ? -1 : c.b;
-    pattern.push_back(((a + 1) << 32) | (b + 1));
-  }
-  // The free unknowns' rows of S H on each movable body (3 entries a body), grouped by body.
-  w.body_start.assign(nb + 1, 0);
-  for (std::size_t k = 0; k < n; ++k)
-    for (std::size_t t = 0; t < 2; ++t) {
-      if (w.col[2 * k + t] < 0) continue;
-      const ContactPoint& c = points_[k];
-      for (const Index body : {c.a, c.b})
-        if (inv[3 * std::size_t(body)] != 0.0) ++w.body_start[std::size_t(body) + 1];
-    }
-  for (std::size_t b = 0; b < nb; ++b) w.body_start[b + 1] += w.body_start[b];
-  w.entry_col.resize(std::size_t(w.body_start[nb]));
-  w.entry_row.resize(std::size_t(w.body_start[nb]));
-  std::vector<int> fill(w.body_start.begin(), w.body_start.end() - 1);
+  std::vector<long long> key(n);
   for (std::size_t k = 0; k < n; ++k) {
     const ContactPoint& c = points_[k];
-    for (std::size_t t = 0; t < 2; ++t) {
-      const std::size_t i = 2 * k + t;
-      if (w.col[i] < 0) continue;
-      const Vec2 dir = t ? Vec2{-c.n.y, c.n.x} : c.n;
-      for (const bool on_b : {false, true}) {
-        const std::size_t body = std::size_t(on_b ? c.b : c.a);
-        if (inv[3 * body] == 0.0) continue;
-        const double rx = on_b ? rb_x_[k] : ra_x_[k], ry = on_b ? rb_y_[k] : ra_y_[k];
-        const double sign = (on_b ? 1.0 : -1.0) * s[i];
-        const std::size_t e = std::size_t(fill[body]++);
-        w.entry_col[e] = w.col[i];
-        w.entry_row[e] = {sign * dir.x, sign * dir.y, sign * (rx * dir.y - ry * dir.x)};
-      }
-    }
+    const long long a = inv[3 * std::size_t(c.a)] == 0.0 ? -1 : c.a;
+    const long long b = inv[3 * std::size_t(c.b)] == 0.0 ? -1 : c.b;
+    key[k] = ((a + 1) << 32) | (b + 1);
   }
-  // A_FF = sum over the bodies of row_i M^-1 row_j (lower triangle), plus the regularisation.
-  w.triplets.clear();
+  const bool same = w.analysed && key == w.key && w.body_start.size() == nb + 1;
+  if (!same) {
+    w.key.swap(key);
+    w.analysed = false;
+    w.body_start.assign(nb + 1, 0);
+    for_each_entry(points_, inv, [&](std::size_t, std::size_t, bool, std::size_t body) {
+      ++w.body_start[body + 1];
+    });
+    for (std::size_t b = 0; b < nb; ++b) w.body_start[b + 1] += w.body_start[b];
+    w.entry_unknown.resize(std::size_t(w.body_start[nb]));
+    w.entry_row.resize(w.entry_unknown.size());
+    std::vector<int> fill(w.body_start.begin(), w.body_start.end() - 1);
+    for_each_entry(points_, inv, [&](std::size_t k, std::size_t t, bool, std::size_t body) {
+      w.entry_unknown[std::size_t(fill[body]++)] = Eigen::Index(2 * k + t);
+    });
+    // A's structure: the diagonal, and (i, j), i < j, for two unknowns on one body.
+    std::vector<Eigen::Triplet<double, Eigen::Index>> entries;
+    for (Eigen::Index i = 0; i < Eigen::Index(m); ++i) entries.emplace_back(i, i, 0.0);
+    for (std::size_t b = 0; b < nb; ++b)
+      for (int e = w.body_start[b]; e < w.body_start[b + 1]; ++e)
+        for (int o = w.body_start[b]; o < w.body_start[b + 1]; ++o) {
+          const Eigen::Index i = w.entry_unknown[std::size_t(e)];
+          const Eigen::Index j = w.entry_unknown[std::size_t(o)];
+          if (j < i) entries.emplace_back(j, i, 0.0);
+        }
+    w.a.resize(Eigen::Index(m), Eigen::Index(m));
+    w.a.setFromTriplets(entries.begin(), entries.end());
+    w.a.makeCompressed();
+    w.pair_position.clear();
+    for (std::size_t b = 0; b < nb; ++b)
+      for (int e = w.body_start[b]; e < w.body_start[b + 1]; ++e)
+        for (int o = w.body_start[b]; o < w.body_start[b + 1]; ++o) {
+          const Eigen::Index i = w.entry_unknown[std::size_t(e)];
+          const Eigen::Index j = w.entry_unknown[std::size_t(o)];
+          if (i < j) continue;
+          const Eigen::Index* rows = w.a.innerIndexPtr();
+          const Eigen::Index* first = rows + w.a.outerIndexPtr()[i];
+          const Eigen::Index* last = rows + w.a.outerIndexPtr()[i + 1];
+          w.pair_position.push_back(Eigen::Index(std::lower_bound(first, last, j) - rows));
+        }
+  }
+  // The rows of S H on each movable body (3 entries a body), in the structure's order.
+  std::vector<int> fill(w.body_start.begin(), w.body_start.end() - 1);
+  for_each_entry(points_, inv, [&](std::size_t k, std::size_t t, bool on_b, std::size_t body) {
+    const ContactPoint& c = points_[k];
+    const std::size_t i = 2 * k + t;
+    const Vec2 dir = t ? Vec2{-c.n.y, c.n.x} : c.n;
+    const double rx = on_b ? rb_x_[k] : ra_x_[k], ry = on_b ? rb_y_[k] : ra_y_[k];
+    const double sign = (on_b ? 1.0 : -1.0) * s[i];
+    w.entry_row[std::size_t(fill[body]++)] = {sign * dir.x, sign * dir.y,
+                                              sign * (rx * dir.y - ry * dir.x)};
+  });
+  // A = sum over the bodies of row_i M^-1 row_j.
+  w.values.assign(std::size_t(w.a.nonZeros()), 0.0);
+  std::size_t pair = 0;
   for (std::size_t body = 0; body < nb; ++body) {
     const double* ib = &inv[3 * body];
     for (int e = w.body_start[body]; e < w.body_start[body + 1]; ++e)
       for (int o = w.body_start[body]; o < w.body_start[body + 1]; ++o) {
-        const int i = w.entry_col[std::size_t(e)], j = w.entry_col[std::size_t(o)];
-        if (i < j) continue;
+        if (w.entry_unknown[std::size_t(e)] < w.entry_unknown[std::size_t(o)]) continue;
         const auto& ri = w.entry_row[std::size_t(e)];
         const auto& rj = w.entry_row[std::size_t(o)];
-        w.triplets.emplace_back(
-            i, j, ri[0] * ib[0] * rj[0] + ri[1] * ib[1] * rj[1] + ri[2] * ib[2] * rj[2]);
+        w.values[std::size_t(w.pair_position[pair++])] +=
+            ri[0] * ib[0] * rj[0] + ri[1] * ib[1] * rj[1] + ri[2] * ib[2] * rj[2];
       }
   }
-  for (int i = 0; i < f; ++i) w.triplets.emplace_back(i, i, kFaceRegularisation);
-  w.a.resize(f, f);
-  w.a.setFromTriplets(w.triplets.begin(), w.triplets.end());
+}
+
+bool NscdContact::face_step(const std::vector<double>& s, const std::vector<char>& free,
+                            const std::vector<double>& g, std::vector<double>& d) const {
+  FaceScratch& w = t_face;
+  const Eigen::Index m = Eigen::Index(2 * points_.size());
+  std::fill(d.begin(), d.end(), 0.0);
+  auto on_face = [&](Eigen::Index i) { return free[std::size_t(i)] && s[std::size_t(i)] > 0.0; };
+  // A_FF with the regularisation on the free face; an identity row and column elsewhere (they
+  // change nothing of the face's factors).
+  bool any = false;
+  const Eigen::Index* outer = w.a.outerIndexPtr();
+  const Eigen::Index* rows = w.a.innerIndexPtr();
+  double* values = w.a.valuePtr();
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const bool fj = on_face(j);
+    any = any || fj;
+    for (Eigen::Index p = outer[j]; p < outer[j + 1]; ++p) {
+      const Eigen::Index i = rows[p];
+      const double v = fj && on_face(i) ? w.values[std::size_t(p)] : 0.0;
+      values[p] = i != j ? v : fj ? v + kFaceRegularisation : 1.0;
+    }
+  }
+  if (!any) return false;
   // The points come in the order of the detection, which follows the blocks along the
   // structure: the natural order keeps the fill small (an approximate minimum degree ordering
   // cost more than it saved).
-  if (!w.analysed || pattern != w.pattern) {
+  if (!w.analysed) {
     w.ldlt.analyzePattern(w.a);
-    w.pattern.swap(pattern);
     w.analysed = true;
   }
   w.ldlt.factorize(w.a);
-  if (w.ldlt.info() != Eigen::Success) {
-    w.analysed = false;
-    return false;
-  }
-  w.rhs.resize(f);
-  for (std::size_t i = 0; i < m; ++i)
-    if (w.col[i] >= 0) w.rhs[w.col[i]] = -g[i];
+  if (w.ldlt.info() != Eigen::Success) return false;
+  w.rhs.resize(m);
+  for (Eigen::Index i = 0; i < m; ++i) w.rhs[i] = on_face(i) ? -g[std::size_t(i)] : 0.0;
   w.x = w.ldlt.solve(w.rhs);
-  for (std::size_t i = 0; i < m; ++i)
-    if (w.col[i] >= 0) d[i] = w.x[w.col[i]];
+  for (Eigen::Index i = 0; i < m; ++i)
+    if (on_face(i)) d[std::size_t(i)] = w.x[i];
   return true;
 }
 

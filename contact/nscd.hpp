@@ -181,11 +181,13 @@ class NscdContact {
   // with W used (the sweeps after it judge its convergence).
   int cone_solve(const std::vector<double>& inv, const std::vector<double>& v_free,
                  const std::vector<double>& u_min, double mu, double tol_v);
-  // The Newton step d = -A_FF^-1 g_F of the cone solve on its free face (free[i]; the scaled
-  // unknowns' scales s); false when the face is empty or its matrix does not factor.
-  bool face_step(const std::vector<double>& inv, const std::vector<double>& s,
-                 const std::vector<char>& free, const std::vector<double>& g,
-                 std::vector<double>& d) const;
+  // The cone solve's matrix A = S W S over all its unknowns (the scaled unknowns' scales s),
+  // assembled for face_step.
+  void assemble_cone_matrix(const std::vector<double>& inv, const std::vector<double>& s) const;
+  // The Newton step d = -A_FF^-1 g_F of the cone solve on its free face (free[i] and s[i] > 0)
+  // from the last assembled A; false when the face is empty or its matrix does not factor.
+  bool face_step(const std::vector<double>& s, const std::vector<char>& free,
+                 const std::vector<double>& g, std::vector<double>& d) const;
 
   // Adds the impulse (rn, rt) of point k to its bodies' velocities v (inverse masses inv; 3 a
   // block each).
