@@ -12,7 +12,7 @@
 // unbalanced-force ratio R (after "R=": the largest out-of-balance load of a free block over
 // its weight, below), the block it is largest on, and the steps since the last sample that
 // ended with the kinetic damping's peak cleared ("resets="): the study of an unbalanced-force
-// rest rule, docs/capacity.md "The unbalanced-force ratio".
+// rest rule, docs/capacity.md "The step of the quasi-static phases", its last paragraph.
 //
 //   build/study_slide DECK LAMBDA [--set KEY=VALUE ...] [--end T] [--every T]
 //       [--qs-settle A] [--qs-trial A] [--mode outgoing|full] [--qs-off T] [--kd-off T]

@@ -51,7 +51,7 @@ inline constexpr double kRigidStepFraction = 0.4;
 // buttressed basket arch), and at 0.5 such a mode turns within one step (omega dt > 1). The
 // kinetic damping then resets the velocities at every second step, and a structure that is
 // not in equilibrium stands still and is called at rest. It happened on church B, and on the buttressed arches at beta 150, whose
-// lambda* it raised by 0.37% (docs/capacity.md, "The kinetic damping froze trials at 0.5").
+// lambda* it raised by 0.37% (docs/capacity.md, "The step of the quasi-static phases").
 // With impact damping (contact.restitution < 1) the dashpot, which acts on the rate of the
 // normal force, must resolve the impact: at the fraction above a drop's rebound misses e^2 by
 // more, so its steps stay at 0.2 (docs/rigid.md, "Impact damping").

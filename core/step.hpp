@@ -96,7 +96,7 @@ struct Simulation {
   // KineticDamping); 0 while ctx.kinetic_damping is 0.
   double kinetic_peak = 0.0;
   // Kinetic-damping resets so far: a diagnostic, read by the capacity trials (a trial whose
-  // every step resets stands still, docs/capacity.md "The kinetic damping froze trials at 0.5").
+  // every step resets stands still, docs/capacity.md "The step of the quasi-static phases").
   long long kinetic_resets = 0;
   // Scratch of the threaded element stage (core/cst.hpp), built at the first large step.
   ElementWorkspace element_work;

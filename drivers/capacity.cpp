@@ -420,7 +420,7 @@ void report(const TrialResult& r, bool quiet, bool resumed) {
                r.lambda, r.collapsed ? "collapsed" : "stable", r.reason.c_str(), r.sim_time,
                r.steps, r.wall_s, resumed ? " [journal]" : "");
   // A trial whose velocities the kinetic damping reset at most of its steps stood still
-  // whatever the forces on it (docs/capacity.md, "The kinetic damping froze trials at 0.5").
+  // whatever the forces on it (docs/capacity.md, "The step of the quasi-static phases").
   if (4 * r.kinetic_resets > r.steps)
     std::fprintf(stderr,
                  "  warning: the kinetic damping reset the velocities at %lld of this trial's %lld "

@@ -293,7 +293,7 @@ TEST(KineticDamping, SwingIsStoppedAtItsEquilibrium) {
 }
 
 // The kinetic damping must never hold still a structure that is not in equilibrium
-// (docs/capacity.md, "The kinetic damping froze trials at 0.5"). The buttressed basket arch
+// (docs/capacity.md, "The step of the quasi-static phases"). The buttressed basket arch
 // at beta 150 loaded at 0.16036, the collapsed end of its bracket: at a
 // quasi-static step of 0.5 of 2 / omega a joint mode of the coupled blocks turned within one
 // step, the kinetic damping reset the velocities at every step from 0.2 s on, and the arch
