@@ -57,12 +57,13 @@
 // gradients on the free face with projections: their products grow like N along a chain where
 // the sweeps grow like N^2), in variables scaled by the Delassus diagonal, with a Newton step
 // on the free face (a sparse LDL^T of W_FF) every few products, kept when it lowers f. Then
-// mu r_n gives the next box, for at most kTrescaPasses boxes. W is applied as H M^-1 H^T,
-// never assembled but on the free face. Two points on every joint make the contacts redundant
-// (W singular): with restitution 0 the gaps' u_min <= 0 keep f bounded below (with a
-// restitution, the cap on the products bounds the solve), and the face's matrix takes a small
-// regularisation. The solution is where the sweeps go on from; they decide convergence, on the
-// same tolerance, and take the cone solve again after every kSweepsBeforeCone sweeps.
+// mu r_n gives the next box, for at most kTrescaPasses boxes. The products apply W as
+// H M^-1 H^T; the Newton steps factor the free face of W, assembled once per cone solve. Two
+// points on every joint make the contacts redundant (W singular): with restitution 0 the gaps'
+// u_min <= 0 keep f bounded below (with a restitution, the cap on the products bounds the
+// solve), and the face's matrix takes a small regularisation. The solution is where the sweeps go
+// on from; they decide convergence, on the same tolerance, and take the cone solve again after
+// every kSweepsBeforeCone sweeps.
 //
 // Energy (the ledger's terms, booked from the impulses, never as a remainder). Over a step the
 // bodies' kinetic energy changes by (h F + P) . (v^- + v^+) / 2 (P: the contact impulses on the
