@@ -25,7 +25,7 @@ three times, labelled `mpi`, where the program is built with MPI:
                   journalled twice.
 
 Settings are the cheap ones of the unit tests (coarse tolerance, soft coarse arch, short
-times): about 30 s of CPU for --part same, 10 s for --part resume, 15 s for --part nscd.
+times): about 30 s of CPU for --part same, 10 s for --part resume, 5 s for --part nscd.
 Usage: tests/python/mpi_ranks.py --bin build/voussoir --mpirun mpirun --work DIR --part same"""
 import argparse
 import csv
