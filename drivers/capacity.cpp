@@ -294,8 +294,8 @@ RunSpec trial_spec(const SettledState& settled, double lambda, const TrialCriter
   auto rest = std::make_unique<RestRule>(v_rest, crit.hold_time, ramp);
   if (crit.quasi_static) rest->refuse_creep(d_collapse, crit.collapse_rotation, kCreepTolerance);
   spec.rules.push_back(std::move(rest));
-  spec.rules.push_back(std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0,
-                                                   ramp, crit.max_time));
+  spec.rules.push_back(
+      std::make_unique<TrendRule>(d_collapse, crit.collapse_rotation, 0.0, ramp, crit.max_time));
   spec.quiet = quiet;
   const double rot_limit = crit.collapse_rotation;
   spec.progress = [lambda, d_collapse, v_rest, rot_limit](const Probe& p, double wall) {
@@ -409,6 +409,14 @@ std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
   for (double v : {cp.penalty, cp.friction, cp.normal_stiffness, cp.joint_young, cp.shear_stiffness,
                    cp.restitution})
     f.value(v);
+  // Non-smooth contact dynamics: its settings, which a block settled still on its ground need
+  // not show (max_iterations never does when no step reaches it), as in the checkpoint's
+  // fingerprint. The explicit scheme hashes without them: its journals stay valid.
+  if (s.sim.ctx.nscd) {
+    f.text("nscd");
+    const NscdSettings& ns = s.sim.ctx.nscd_settings;
+    for (double v : {ns.theta, ns.tolerance, double(ns.max_iterations)}) f.value(v);
+  }
   return f.hex();
 }
 

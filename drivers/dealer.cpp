@@ -6,7 +6,8 @@
 //                          cell's result); one thread of a rank at a time (it then waits for the
 //                          answer, so answers reach the thread that asked)
 //   kTagCell  0 -> rank r  {"cell": c, "input": ...}, or {"cell": -1}: nothing left, stop
-//   kTagDone  rank r -> 0  every thread of rank r has stopped
+//   kTagDone  rank r -> 0  every thread of rank r has stopped; what its cells added to the
+//                          contact solver's record (drivers/solver_report.hpp)
 //   kTagShare 0 -> rank r  share_from_dealer's value
 //   kTagExit  0 -> rank r  rank 0 is at its end: MPI_Finalize (a collective) may start
 // Every receive polls with MPI_Iprobe and sleeps 1 ms between empty polls instead of blocking:
@@ -26,6 +27,7 @@
 #include <thread>
 
 #include "core/schema.hpp"
+#include "drivers/solver_report.hpp"
 #include "voussoir/config.hpp"
 
 #if VOUSSOIR_MPI
@@ -152,6 +154,7 @@ void deal_as_dealer(const CellWork& w, int threads) {
         MPI_Status status;
         const std::string text = receive_text(MPI_ANY_SOURCE, MPI_ANY_TAG, &status);
         if (status.MPI_TAG == kTagDone) {
+          note_solver_runs(nlohmann::json::parse(text));
           ++done;
           continue;
         }
@@ -171,6 +174,7 @@ void deal_as_dealer(const CellWork& w, int threads) {
 // Ranks 1 to N-1: each thread asks rank 0 for a cell, runs it, sends its record with the next
 // ask, until rank 0 has no cell left.
 void deal_as_worker(const CellWork& w, int threads) {
+  const NscdStats solver_start = solver_record();
 #pragma omp parallel num_threads(g_serialized ? threads : 1)
   {
     nlohmann::json ask = nlohmann::json::object();
@@ -189,7 +193,7 @@ void deal_as_worker(const CellWork& w, int threads) {
       ask = {{"cell", c}, {"record", w.run(c, deal["input"])}};
     }
   }
-  send_text("", 0, kTagDone);
+  send_text(solver_runs_since(solver_start).dump(), 0, kTagDone);
 }
 
 #endif  // VOUSSOIR_MPI

@@ -27,6 +27,35 @@ void note_solver_runs(const NscdStats& end, const NscdStats& start) {
   g_record.max_penetration = std::max(g_record.max_penetration, end.max_penetration);
 }
 
+namespace {
+
+nlohmann::json stats_json(const NscdStats& r) {
+  return {r.steps,          r.unconverged_steps, r.iterations,     r.cone_steps,
+          r.max_iterations, r.max_residual,      r.max_penetration};
+}
+
+NscdStats stats_of(const nlohmann::json& j) {
+  NscdStats r;
+  r.steps = j.at(0);
+  r.unconverged_steps = j.at(1);
+  r.iterations = j.at(2);
+  r.cone_steps = j.at(3);
+  r.max_iterations = j.at(4);
+  r.max_residual = j.at(5);
+  r.max_penetration = j.at(6);
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json solver_runs_since(const NscdStats& start) {
+  return {{"start", stats_json(start)}, {"end", stats_json(solver_record())}};
+}
+
+void note_solver_runs(const nlohmann::json& runs) {
+  note_solver_runs(stats_of(runs.at("end")), stats_of(runs.at("start")));
+}
+
 NscdStats solver_record() {
   const std::lock_guard<std::mutex> lock(g_mutex);
   return g_record;

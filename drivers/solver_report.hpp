@@ -5,8 +5,9 @@
 // Every run of the engine (drivers/trial.hpp run_engine) adds the record of its own steps to
 // one record of the process (note_solver_runs), which the commands write: the settle, each
 // trial, pulse run and cell alike. Sums and largest values do not depend on the order in which
-// threads add them. Under MPI each rank keeps its own: the JSON of rank 0 holds the runs of
-// rank 0 (docs/nscd.md says so).
+// threads add them. Under MPI each rank keeps its own, and each of ranks 1 to N-1 sends rank 0
+// what its cells added (solver_runs_since) when it stops (drivers/dealer.cpp): the JSON of
+// rank 0 holds every rank's cells.
 
 #include <nlohmann/json.hpp>
 #include <string>
@@ -22,6 +23,10 @@ inline constexpr double kUnconvergedShare = 0.01;
 
 // Adds the steps of one run (its record at the end less the one at its start).
 void note_solver_runs(const NscdStats& end, const NscdStats& start);
+// What the runs since the record `start` added, as JSON ({"start": ..., "end": ...}, the
+// records' fields), and its addition to this process's record (the message of an MPI rank).
+nlohmann::json solver_runs_since(const NscdStats& start);
+void note_solver_runs(const nlohmann::json& runs);
 // The process's record so far, and its reset (tests, and commands that run twice).
 NscdStats solver_record();
 void reset_solver_record();

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The studies under `mpirun -n 2` against one process (SPEC section 2, docs/mpi.md). ctest runs it
-twice, labelled `mpi`, where the program is built with MPI:
+three times, labelled `mpi`, where the program is built with MPI:
 
   --part same     a 12-cell sweep (cases/block.toml, friction x width), a 16-cell corner of the
                   Gilbert stability map, a 4-frequency pulse curve and an IDA of a slender block
@@ -13,9 +13,19 @@ twice, labelled `mpi`, where the program is built with MPI:
                   a line (what a kill leaves); the MPI sweep resumed: the same CSV as the
                   uninterrupted one (the 5 kept cells with their journalled wall_s), the count of
                   kept cells on stderr, and every cell journalled once (none run twice).
+  --part nscd     the same under non-smooth contact dynamics (solver.scheme = "nscd", rigid
+                  blocks; docs/nscd.md): a 12-cell sweep and an IDA of the slender block under 3
+                  records, each without mpirun (2 threads), under mpirun -n 1 (2 threads) and
+                  under mpirun -n 2 (1 thread a rank): the same CSVs byte for byte once the
+                  wall_s column is removed, and the same JSON in full precision (the contact
+                  solver's record of every rank's runs included) once the walls, paths and
+                  ranks are removed; then each cut and resumed under mpirun -n 2 (the sweep's
+                  journal after 5 cells and half a line, the IDA's after its first record's
+                  runs and half a line): the uninterrupted CSVs and JSON again, nothing
+                  journalled twice.
 
 Settings are the cheap ones of the unit tests (coarse tolerance, soft coarse arch, short
-times): about 30 s of CPU for --part same, 10 s for --part resume.
+times): about 30 s of CPU for --part same, 10 s for --part resume, 5 s for --part nscd.
 Usage: tests/python/mpi_ranks.py --bin build/voussoir --mpirun mpirun --work DIR --part same"""
 import argparse
 import csv
@@ -28,7 +38,7 @@ import subprocess
 from checks import SOURCE, check, finish
 
 # mpirun as root (CI) and with more ranks than free cores (2 shared cores).
-MPI_FLAGS = ["--allow-run-as-root", "--oversubscribe", "-n", "2"]
+MPI_FLAGS = ["--allow-run-as-root", "--oversubscribe"]
 
 SWEEP = ["sweep", os.path.join(SOURCE, "cases", "block.toml"), "--set", "capacity.tolerance=0.05",
          "--param", "contact.friction=0.2,0.3,0.6,0.9", "--param", "model.width=0.3,0.5,0.7"]
@@ -46,6 +56,14 @@ CURVE = ["pulse", os.path.join(SOURCE, "cases", "block.toml"), "--set", "mesh.si
 IDA = ["ida", os.path.join(SOURCE, "cases", "block.toml"), "--set", "model.width=0.2",
        "--set", 'material.model="rigid"', "--set", "contact.normal_stiffness=1e10",
        "--set", "contact.shear_stiffness=1e10", "--lambda-star", "0.2"]
+
+
+# Non-smooth contact dynamics of the rigid blocks (docs/nscd.md): the block's sweep (a capacity
+# search a cell) and the slender block's IDA (a record's intensity search a cell).
+NSCD = ["--set", 'material.model="rigid"', "--set", 'solver.scheme="nscd"']
+NSCD_SWEEP = SWEEP + NSCD
+NSCD_IDA = ["ida", os.path.join(SOURCE, "cases", "block.toml"), "--set", "model.width=0.2",
+            "--lambda-star", "0.2"] + NSCD
 
 
 def write_records(work):
@@ -85,15 +103,33 @@ def rows_without_wall(path):
     return [r[:k] + r[k + 1:] for r in rows]
 
 
-def study(a, name, args, ranks, extra=()):
-    """One run of a study, in one process of 2 threads (ranks 1) or under mpirun with 1 thread
-    a rank; returns its paths and its (status, stdout, stderr)."""
-    out = os.path.join(a.work, f"{name}_{ranks}")
+# What a study's JSON may change with the ranks: walls, output paths and the ranks.
+VARYING = {"wall_s", "capacity_wall_s", "csv", "runs_csv", "ranks"}
+
+
+def json_results(path, varying=VARYING):
+    """A study's JSON with the `varying` keys left out at every level."""
+    def strip(v):
+        if isinstance(v, dict):
+            return {k: strip(x) for k, x in v.items() if k not in varying}
+        if isinstance(v, list):
+            return [strip(x) for x in v]
+        return v
+    with open(path) as f:
+        return strip(json.load(f))
+
+
+def study(a, name, args, ranks, extra=(), mpirun=None):
+    """One run of a study, in one process of 2 threads (ranks 1) or under mpirun -n ranks with 1
+    thread a rank (2 threads for one rank); mpirun: whether to start it by mpirun (by default
+    when ranks > 1). Returns its paths and its (status, stdout, stderr)."""
+    mpirun = ranks > 1 if mpirun is None else mpirun
+    out = os.path.join(a.work, f"{name}_{ranks}" + ("_mpirun" if mpirun and ranks == 1 else ""))
     threads = "2" if ranks == 1 else "1"
     cmd = [a.bin] + args + ["--threads", threads, "--csv", out + ".csv", "--json", out + ".json"]
     cmd += list(extra)
-    if ranks > 1:
-        cmd = [a.mpirun] + MPI_FLAGS + cmd
+    if mpirun:
+        cmd = [a.mpirun] + MPI_FLAGS + ["-n", str(ranks)] + cmd
     return out, run(cmd)
 
 
@@ -182,17 +218,92 @@ def resume(a):
     check(sorted(cells) == list(range(12)), f"journal cells after the resume: {sorted(cells)}")
 
 
+def nscd(a):
+    """--part nscd (module comment)."""
+    records = write_records(a.work)
+    ida = NSCD_IDA + ["--records", records]
+    for name, args in (("nscd_sweep", NSCD_SWEEP), ("nscd_ida", ida)):
+        # Without mpirun (2 threads), under mpirun -n 1 (2 threads) and -n 2 (1 thread a rank).
+        runs = []
+        for ranks, mpirun in ((1, False), (1, True), (2, True)):
+            out, (rc, _, err) = study(a, name, args, ranks, mpirun=mpirun)
+            check(rc == 0, f"{name}, {ranks} ranks (mpirun: {mpirun}): exit {rc}\n{err[-2000:]}")
+            if rc == 0:
+                runs.append((ranks, out, err))
+        if len(runs) != 3:
+            continue
+        tables = ["", "_runs"] if name == "nscd_ida" else [""]
+        first = runs[0][1]
+        for ranks, out, err in runs:
+            for t in tables:
+                r0, r1 = rows_without_wall(first + t + ".csv"), rows_without_wall(out + t + ".csv")
+                check(len(r0) > 3 and r0 == r1,
+                      f"{name}: {out}{t}.csv differs from {first}{t}.csv (wall_s aside):\n{r0}\n{r1}")
+            # The JSON's numbers in full (the runs CSV rounds them), the contact solver's record
+            # of every rank's runs included.
+            check(json_results(first + ".json") == json_results(out + ".json"),
+                  f"{name}: {out}.json differs from {first}.json (walls, paths, ranks aside):\n"
+                  f"{json_results(first + '.json').get('solver')}\n"
+                  f"{json_results(out + '.json').get('solver')}")
+            j = json.load(open(out + ".json"))
+            check(j.get("ranks") == ranks, f"{name}: JSON ranks {j.get('ranks')}, expected {ranks}")
+            check(j.get("solver", {}).get("scheme") == "nscd",
+                  f"{name}: the JSON's solver record is not nscd's: {j.get('solver')}")
+        check("2 ranks" in runs[2][2], f"{name}: no dealing line on stderr:\n{runs[2][2][-2000:]}")
+    check(len(rows_without_wall(os.path.join(a.work, "nscd_sweep_1.csv"))) == 13,
+          "nscd sweep: not 12 cells")
+
+    # Cut and resumed under mpirun -n 2: the sweep's journal after 5 cells and half a line, the
+    # IDA's after the runs of its first finished record (a record's runs reach the journal
+    # together under MPI: docs/mpi.md) and half a line.
+    for name, args, count in (("nscd_sweep", NSCD_SWEEP, None), ("nscd_ida", ida, "record")):
+        journal = os.path.join(a.work, name + ".journal")
+        full, (rc, _, err) = study(a, name + "_full", args, 2, ["--resume", journal])
+        check(rc == 0, f"{name}: uninterrupted MPI run: exit {rc}\n{err[-2000:]}")
+        if rc != 0:
+            continue
+        lines = open(journal).read().splitlines()
+        records = [json.loads(l) for l in lines[1:]]
+        if count is None:
+            kept = 5
+        else:
+            kept = sum(1 for r in records if r[count] == records[0][count])
+        check(len(records) > kept, f"{name}: the journal holds {len(records)} records only")
+        with open(journal, "w") as f:
+            f.write("\n".join(lines[:1 + kept]) + "\n" + lines[1 + kept][: len(lines[1 + kept]) // 2])
+        resumed, (rc, _, err) = study(a, name + "_resumed", args, 2, ["--resume", journal])
+        check(rc == 0, f"{name}: resumed MPI run: exit {rc}\n{err[-2000:]}")
+        if rc != 0:
+            continue
+        tables = ["", "_runs"] if name == "nscd_ida" else [""]
+        for t in tables:
+            check(rows_without_wall(full + t + ".csv") == rows_without_wall(resumed + t + ".csv"),
+                  f"{name}: the resumed {t or 'main'} CSV differs from the uninterrupted one")
+        # (The solver's record counts the runs made, not those taken from the journal.)
+        resumed_varying = VARYING | {"solver"}
+        check(json_results(full + ".json", resumed_varying) ==
+              json_results(resumed + ".json", resumed_varying),
+              f"{name}: the resumed JSON differs from the uninterrupted one (walls aside)")
+        # Nothing journalled twice: each cell, each record's run at an intensity, once.
+        def key(r):
+            return r["cell"] if count is None else (r["record"], r["amplitude"])
+        again = cell_records(journal)
+        check(sorted(map(key, again)) == sorted(map(key, records)),
+              f"{name}: the resumed journal's records differ from the uninterrupted one's: "
+              f"{sorted(map(key, again))} against {sorted(map(key, records))}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--bin", required=True)
     ap.add_argument("--mpirun", required=True)
     ap.add_argument("--work", required=True)
-    ap.add_argument("--part", choices=["same", "resume"], required=True)
+    ap.add_argument("--part", choices=["same", "resume", "nscd"], required=True)
     a = ap.parse_args()
     a.work = os.path.abspath(os.path.join(a.work, a.part))
     shutil.rmtree(a.work, ignore_errors=True)
     os.makedirs(a.work)
-    same(a) if a.part == "same" else resume(a)
+    {"same": same, "resume": resume, "nscd": nscd}[a.part](a)
     finish(f"mpi_ranks --part {a.part}")
 
 

@@ -78,17 +78,17 @@ inline std::string rocking_deck(const std::string& record_path, double amplitude
   return deck;
 }
 
-// The angular velocity the block of `deck` keeps at an impact: released at rest from
-// `tilt_fraction` of its slenderness angle on its left corner, the ratio of the angular
-// velocities just after and just before the first impact, each read a tenth of the tilt from
-// upright and brought to upright by the free-rocking energy (as Rigid.RockingBlockImpact
-// ConvergesAsTheJointStiffens reads them). -1 if no impact within 3 s.
-inline double measured_restitution(const std::string& deck, double tilt_fraction) {
+// The angular velocity the block of `deck` (the rectangle `block`) keeps at an impact:
+// released at rest from `tilt_fraction` of its slenderness angle on its left corner, the ratio
+// of the angular velocities just after and just before the first impact, each read a tenth of
+// the tilt from upright and brought to upright by the free-rocking energy (as Rigid.Rocking
+// BlockImpactConvergesAsTheJointStiffens reads them). -1 if no impact within 3 s.
+inline double measured_restitution(const std::string& deck, double tilt_fraction,
+                                   const HousnerBlock& block = rocking_block()) {
   Simulation sim = make_simulation(parse_deck(deck, "rocking"));
   Model& m = sim.model;
   Index b = 0;
   while (m.blocks[std::size_t(b)].fixed) ++b;
-  const HousnerBlock block = rocking_block();
   const double alpha = block.alpha(), p2 = block.p2();
   const double th0 = tilt_fraction * alpha, probe = 0.1 * th0;
   const double px = m.rigid.cx0[b] - block.b, py = m.rigid.cy0[b] - block.h;  // left corner
@@ -117,14 +117,18 @@ struct ScaleResult {
   bool fell_at_housner_r = false;
   bool ran = false;  // in voussoir
   PulseResult run;
-  double max_slip = 0.0;  // [m] run_rocking
+  double max_slip = -1.0;  // [m] run_rocking (-1: not measured)
 };
 
+// A ground motion scanned in scale: a record (its AT2 file) or a windowed sine
+// (tests/unit/rocking_sines.hpp, which sets the block and the fall rotation of its own).
 struct RecordStudy {
   RecordSpec spec;
   std::string path;     // the AT2 file
   GroundRecord record;  // as written
   std::vector<ScaleResult> scales;
+  HousnerBlock block = rocking_block();
+  double fall_rotation = 1.0;  // [rad] the reference's fall (HousnerOptions::fall_rotation)
 };
 
 // The three records, written to `dir` as AT2 files.
@@ -148,21 +152,27 @@ inline std::vector<RecordStudy> rocking_records(const std::string& dir) {
   return studies;
 }
 
-inline bool housner_falls(const RecordStudy& st, double scale, double r) {
+// The reference's options for a study at impact ratio r.
+inline HousnerOptions study_options(const RecordStudy& st, double r) {
   HousnerOptions opt;
   opt.restitution = r;
-  return housner_response(rocking_block(), st.record, scale, opt).fell;
+  opt.fall_rotation = st.fall_rotation;
+  return opt;
 }
 
-// The reference over the scan (header comment), at impact ratio r.
-inline void scan_reference(RecordStudy& st, double r) {
-  const double r_housner = rocking_block().housner_restitution();
-  for (double s = kFirstScale; s <= kLastScale * 1.0001; s *= kScaleStep) {
+inline bool housner_falls(const RecordStudy& st, double scale, double r) {
+  return housner_response(st.block, st.record, scale, study_options(st, r)).fell;
+}
+
+// The reference over the scan (header comment) from `first` to `last` [g] in steps of
+// kScaleStep, at impact ratio r.
+inline void scan_reference(RecordStudy& st, double r, double first = kFirstScale,
+                           double last = kLastScale) {
+  const double r_housner = st.block.housner_restitution();
+  for (double s = first; s <= last * 1.0001; s *= kScaleStep) {
     ScaleResult x;
     x.scale = s;
-    HousnerOptions opt;
-    opt.restitution = r;
-    x.nominal = housner_response(rocking_block(), st.record, s, opt);
+    x.nominal = housner_response(st.block, st.record, s, study_options(st, r));
     const bool fell = x.nominal.fell;
     x.robust = true;
     for (double f : {0.95, 1.0, 1.05})
@@ -275,7 +285,6 @@ inline void print_chaos(const RecordStudy& st, double r) {
 
 // The voussoir runs as a Markdown table.
 inline void print_runs(const std::vector<RecordStudy>& studies) {
-  const double alpha = rocking_block().alpha();
   std::printf(
       "| record | PGA [g] | Housner | robust | max rotation / alpha | voussoir | "
       "max rotation / alpha | decided at [s] | pivot slip [mm] | wall [s] |\n"
@@ -283,16 +292,30 @@ inline void print_runs(const std::vector<RecordStudy>& studies) {
   for (const RecordStudy& st : studies)
     for (const ScaleResult& x : st.scales) {
       if (!x.ran) continue;
-      std::printf("| %s | %.3f | %s | %s | %.3f | %s (%s) | %.3f | %.2f | %.3f | %.2f |\n",
+      const double alpha = st.block.alpha();
+      char slip[32] = "-";
+      if (x.max_slip >= 0.0) std::snprintf(slip, sizeof slip, "%.3f", 1e3 * x.max_slip);
+      std::printf("| %s | %.3f | %s | %s | %.3f | %s (%s) | %.3f | %.2f | %s | %.2f |\n",
                   st.spec.name.c_str(), x.scale, x.nominal.fell ? "falls" : "survives",
                   !x.robust      ? "no"
                   : x.dense == 1 ? "dense"
                   : x.dense == 0 ? "9 points"
                                  : "yes",
                   x.nominal.max_rotation / alpha, x.run.collapsed ? "falls" : "survives",
-                  x.run.reason.c_str(), x.run.max_rotation / alpha, x.run.decided_at,
-                  1e3 * x.max_slip, x.run.wall_s);
+                  x.run.reason.c_str(), x.run.max_rotation / alpha, x.run.decided_at, slip,
+                  x.run.wall_s);
     }
+}
+
+// The scans from `first` to `last` [g] (a line each, print_chaos) and the runs (print_runs).
+inline void print_scans(const std::vector<RecordStudy>& studies, double r, double first,
+                        double last) {
+  std::printf(
+      "[rocking] scan %.2f to %.2f g in steps of %.0f%%; S / F robust survival / fall, "
+      "s / f not robust\n",
+      first, last, 100.0 * (kScaleStep - 1.0));
+  for (const RecordStudy& st : studies) print_chaos(st, r);
+  print_runs(studies);
 }
 
 }  // namespace voussoir::testing

@@ -114,12 +114,7 @@ void check_against_housner(const std::string& scheme, bool falls_on_every_record
     }
   EXPECT_GE(falls_found, kPerOutcome);
 
-  std::printf(
-      "[rocking] scan %.2f to %.2f g in steps of %.0f%%; S / F robust survival / fall, "
-      "s / f not robust\n",
-      kFirstScale, kLastScale, 100.0 * (kScaleStep - 1.0));
-  for (const RecordStudy& st : studies) print_chaos(st, r);
-  print_runs(studies);
+  print_scans(studies, r, kFirstScale, kLastScale);
   std::printf(
       "[rocking] %s: voussoir agrees at %d of %d dense-robust scales; reference scans %.1f s, "
       "voussoir runs %.1f s, in all %.1f s of wall\n",
