@@ -389,10 +389,12 @@ TEST(Ida, SlenderBlockUnderThreeRecords) {
   // The interval of the median: two numbers around it, or null where the records leave it
   // unbounded.
   ASSERT_EQ(fr.at("median_ci").size(), 2u);
-  if (!fr.at("median_ci")[0].is_null())
+  if (!fr.at("median_ci")[0].is_null()) {
     EXPECT_LE(fr.at("median_ci")[0].get<double>(), fr.at("median").get<double>());
-  if (!fr.at("median_ci")[1].is_null())
+  }
+  if (!fr.at("median_ci")[1].is_null()) {
     EXPECT_GE(fr.at("median_ci")[1].get<double>(), fr.at("median").get<double>());
+  }
 
   // Sa(0.5 s): the same PGAs, intensities scaled by the record's own ratio.
   const double period = 0.5;
