@@ -216,6 +216,11 @@ int main(int argc, char** argv) {
       ->add_option("--thrust", limit_opts.thrust,
                    "least (min) or greatest (max) horizontal support thrust under gravity")
       ->check(CLI::IsMember({"min", "max"}));
+  limit
+      ->add_option("--open-joints", limit_opts.open_joints,
+                   "with [supports] moves: the joints that opened closed over their face "
+                   "(default) or point contacts at their pivots")
+      ->check(CLI::IsMember({"closed", "points"}));
 
   voussoir::SpreadOptions spread_opts;
   CLI::App* spread = app.add_subcommand(

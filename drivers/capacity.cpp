@@ -204,11 +204,16 @@ Model mirror_x(const Model& model) {
   return m;
 }
 
-MovedBlocks moved_blocks(const Simulation& sim, bool mirror) {
+MovedBlocks moved_blocks(const Simulation& sim, bool mirror, OpenJoints open) {
   MovedBlocks out;
   out.model = sim.model;
   sync_rigid_nodes(out.model);
   const std::vector<BlockMotion> motion = block_motions(out.model);
+  if (open == OpenJoints::Points) {
+    const double tol = kHingeFraction * reference_length(out.model);
+    for (const Hinge& h : find_hinges(out.model, tol, tol))
+      if (h.kind == "hinge") out.point_contacts.push_back(h);
+  }
   for (std::size_t b = 0; b < motion.size(); ++b)
     for (Vec2& p : out.model.blocks[b].polygon) p = move_point(motion[b], p);
   auto carried = [&](Index a, Index b, Vec2 p) {
@@ -225,6 +230,8 @@ MovedBlocks moved_blocks(const Simulation& sim, bool mirror) {
     f.a = carried(f.block_a, f.block_b, f.a);
     f.b = carried(f.block_a, f.block_b, f.b);
     f.normal = {c * f.normal.x - s * f.normal.y, s * f.normal.x + c * f.normal.y};
+    for (const Hinge& h : out.point_contacts)
+      if (h.joint == f.joint) (h.side == "intrados" ? f.open_b : f.open_a) = true;
     out.interfaces.push_back(f);
   }
   if (mirror) {

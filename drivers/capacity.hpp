@@ -165,17 +165,25 @@ Model mirror_x(const Model& model);
 // block_motions), and the interfaces of the reference outlines, each end carried by the mean
 // of its two blocks' motions and its normal turned by their mean rotation (an open hinge's
 // faces no longer meet face to face, so find_interfaces would not find them; the joint gaps
-// are a small fraction of the joint length), so the LP takes every joint as closed. Tried and
-// rejected: an open hinge (find_hinges, kHingeFraction L_ref) kept as a point contact at its
-// pivot. A symmetric spread opens both joints of the crown block, and the LP then sees a
-// four-hinge chain: lambda_la = 1e-6 on the semicircular arch spread by 0.5% to 2% of its
-// span, where the FDEM arch carries 0.26 to 0.29 (docs/supports.md). `mirror`: mirrored about
-// x = 0 (mirror_x), for the load towards -x.
+// are a small fraction of the joint length). What the LP makes of the joints that opened
+// (OpenJoints):
+//   Closed  every joint is closed over its whole face: the LP sees a thicker arch than the
+//           one that stands on its open hinges, and overestimates it;
+//   Points  a joint open as the reports say (find_hinges, kHingeFraction L_ref: its largest gap
+//           beyond that or a quarter of the model's largest) is a point contact at its pivot
+//           (Interface::open_a / open_b on its other end): the LP sees the hinges that stand,
+//           not that a hinge open by a millimetre closes under a small load, and
+//           underestimates it. A symmetric spread opens both joints of the crown block, and the
+//           semicircular arch is then a four-hinge chain: lambda_la near 0 (docs/supports.md).
+// `mirror`: mirrored about x = 0 (mirror_x), for the load towards -x.
+enum class OpenJoints { Closed, Points };
 struct MovedBlocks {
   Model model;
   std::vector<Interface> interfaces;
+  std::vector<Hinge> point_contacts;  // OpenJoints::Points: the open joints, each at its pivot
 };
-MovedBlocks moved_blocks(const Simulation& sim, bool mirror = false);
+MovedBlocks moved_blocks(const Simulation& sim, bool mirror = false,
+                         OpenJoints open = OpenJoints::Closed);
 
 // Limit analysis (lambda_la towards +x, or towards -x when direction < 0) of the blocks of a
 // settled state: of the reference outlines when no support moved (bit for bit the plain

@@ -4,7 +4,9 @@
 // horizontal thrust on the supports under self-weight ("thrust_min" / "thrust_max" in N per
 // model.out_of_plane; --mechanism-out then carries that equilibrium's line of thrust, the
 // centres of pressure of the interfaces, for scripts/draw). Friction: contact.friction
-// (associative, so an upper bound where sliding governs); gravity: load.gravity.
+// (associative, so an upper bound where sliding governs); gravity: load.gravity. With
+// [supports] moves, the blocks where the movement leaves them, their open joints closed or
+// (--open-joints points) point contacts at their pivots.
 
 #include <chrono>
 #include <cmath>
@@ -100,6 +102,11 @@ int command_limit(const Config& config, const CommonOptions& common,
     throw DeckError("limit --thrust " + opts.thrust +
                     " with --gravity-only: give one of them (--thrust bounds the thrust under "
                     "gravity alone already)");
+  const bool points = opts.open_joints == "points";
+  if (points && config.supports.moves.empty())
+    throw DeckError(
+        "limit --open-joints points needs [supports] moves: without them the "
+        "blocks stand as built, every joint closed");
   // [supports]: the blocks where the support movement leaves them (settled under gravity and
   // moved as `capacity` does it, then carried rigidly: drivers/capacity.hpp moved_blocks).
   MovedBlocks moved;
@@ -110,7 +117,7 @@ int command_limit(const Config& config, const CommonOptions& common,
     const SettledState settled = settle(config, crit, common.quiet);
     if (!settled.settled)
       throw RunError(config.deck_path + ": " + unsettled_message(settled, crit));
-    moved = moved_blocks(settled.sim);
+    moved = moved_blocks(settled.sim, false, points ? OpenJoints::Points : OpenJoints::Closed);
     options.interfaces = &moved.interfaces;
   }
   const Model model = options.interfaces ? moved.model : build_model(scene_params(config));
@@ -131,6 +138,11 @@ int command_limit(const Config& config, const CommonOptions& common,
   std::printf("deck        %s\n", config.deck_path.c_str());
   std::printf("model       %s: %d free blocks, %zu interfaces (mu = %.4g)\n", model.kind.c_str(),
               res.free_blocks, res.interfaces.size(), mu);
+  if (options.interfaces) {
+    std::printf("open joints %s", points ? "point contacts at their pivots:" : "closed");
+    for (const Hinge& h : moved.point_contacts) std::printf(" %d (%s)", h.joint, h.side.c_str());
+    std::printf("%s\n", points && moved.point_contacts.empty() ? " none opened" : "");
+  }
   std::printf("LP          %d rows x %d columns, %d iterations, %s, %.3f s\n", res.rows,
               res.columns, res.iterations, res.exact ? "exact check passed" : "no exact check",
               res.wall_s);
@@ -190,6 +202,13 @@ int command_limit(const Config& config, const CommonOptions& common,
                         {"lp_wall_s", res.wall_s},
                         {"model_wall_s", model_s},
                         {"wall_s", wall_s}};
+    if (options.interfaces) {
+      nlohmann::json joints = nlohmann::json::array();
+      for (const Hinge& h : moved.point_contacts)
+        joints.push_back({{"joint", h.joint}, {"side", h.side}, {"opening", h.opening}});
+      j["open_joints"] = opts.open_joints;
+      j["point_contacts"] = joints;
+    }
     if (thrust) {
       j[thrust_key] = number_or_null(res.thrust);
       j["out_of_plane"] = model.out_of_plane;

@@ -30,6 +30,10 @@ struct Interface {
   Vec2 normal;       // unit normal pointing from block_a into block_b
   Index joint = -1;  // index of the matching Model::joints entry, -1 if none
   double position_deg = std::numeric_limits<double>::quiet_NaN();  // of the matching joint
+  // Ends that carry no force: the LP fixes their cone edges at zero. Set for the open joints
+  // of a structure whose supports moved, each kept as a point contact at its pivot
+  // (drivers/capacity.hpp moved_blocks, OpenJoints::Points); find_interfaces sets neither.
+  bool open_a = false, open_b = false;
   double length() const;
 };
 

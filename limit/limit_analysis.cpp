@@ -7,7 +7,9 @@
 // and -F_e on block a. The friction cone of one end has two edges, so it is written exactly
 // as F_e = f+ (n + mu t) + f- (n - mu t) with f+, f- >= 0 (N = f+ + f-, S = mu (f+ - f-)): the
 // LP then has only bounds on its columns and one equality row per equilibrium equation. With
-// mu = 0 the two edges coincide and only f+ is kept. Plus the load factor lambda (free).
+// mu = 0 the two edges coincide and only f+ is kept. Plus the load factor lambda (free). An
+// end marked open (Interface::open_a, open_b: an open joint kept as a point contact at its
+// other end) carries none: its columns are fixed at 0.
 //
 // Equilibrium of each free block i (weight W_i = rho A_i out_of_plane g at the centroid c_i,
 // horizontal load lambda W_i at c_i, moments about a reference point O):
@@ -214,7 +216,8 @@ LimitResult solve_limit_lp(const Model& model, double mu, double gravity, Object
     const Vec2 d{f.normal.x + cols[c].sign * mu * t.x, f.normal.y + cols[c].sign * mu * t.y};
     const Vec2 r = scaled(cols[c].end == 0 ? f.a : f.b);
     const double m = r.x * d.y - r.y * d.x;
-    glp_set_col_bnds(P, col, GLP_LO, 0.0, 0.0);
+    const bool open = cols[c].end == 0 ? f.open_a : f.open_b;  // no force at an open end
+    glp_set_col_bnds(P, col, open ? GLP_FX : GLP_LO, 0.0, 0.0);
     if (thrust && 0.5 * (f.a.x + f.b.x) < x_weight) {
       // Outward (-x) force on the fixed block of a left support interface (header).
       if (model.blocks[f.block_b].fixed) glp_set_obj_coef(P, col, -d.x);
@@ -351,8 +354,9 @@ LimitResult solve_limit_lp(const Model& model, double mu, double gravity, Object
         m.x = 0.5 * (f.a.x + f.b.x);
         m.y = 0.5 * (f.a.y + f.b.y);
       } else {
-        const bool pivot_a = m.opening_a <= m.opening_b;
-        m.kind = std::min(m.opening_a, m.opening_b) <= tol ? "hinge" : "separation";
+        // A point contact (an open end) turns about its closed end whatever the open end does.
+        const bool pivot_a = f.open_b || (!f.open_a && m.opening_a <= m.opening_b);
+        m.kind = (pivot_a ? m.opening_a : m.opening_b) <= tol ? "hinge" : "separation";
         m.side = pivot_a ? "intrados" : "extrados";
         m.x = pivot_a ? f.a.x : f.b.x;
         m.y = pivot_a ? f.a.y : f.b.y;

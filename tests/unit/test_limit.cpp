@@ -192,6 +192,33 @@ TEST(LimitBlock, OverturnsAtWidthOverHeightOrSlidesAtMu) {
   }
 }
 
+// An interface end marked open carries no force (the open joints of a moved structure as point
+// contacts, drivers/capacity.hpp OpenJoints::Points). The block (b/h = 0.5, mu = 0.8) on its
+// right toe alone stands only where the load's moment about the toe balances the weight's:
+// lambda = +b/h, the one admissible value; on its left toe alone, lambda = -b/h. Neither stands
+// under gravity alone.
+TEST(LimitBlock, AnOpenEndCarriesNoForce) {
+  const Model m = case_model("block");
+  std::vector<Interface> faces = find_interfaces(m);
+  ASSERT_EQ(faces.size(), 1u);
+  ASSERT_LT(faces[0].a.x, faces[0].b.x);  // a: the left toe, b: the right toe
+  for (const bool right_toe : {true, false}) {
+    std::vector<Interface> point = faces;
+    (right_toe ? point[0].open_a : point[0].open_b) = true;
+    LimitOptions options;
+    options.interfaces = &point;
+    const LimitResult r = limit_analysis(m, 0.8, 9.81, false, options);
+    ASSERT_EQ(r.status, "optimal") << right_toe;
+    EXPECT_NEAR(r.lambda_la, right_toe ? 0.5 : -0.5, 1e-9);
+    ASSERT_EQ(r.forces.size(), 1u);
+    EXPECT_EQ(right_toe ? r.forces[0].normal_a : r.forces[0].normal_b, 0.0);
+    ASSERT_EQ(r.mechanism.size(), 1u);
+    EXPECT_EQ(r.mechanism[0].kind, "hinge");
+    EXPECT_NEAR(r.mechanism[0].x, right_toe ? 0.25 : -0.25, 1e-12);
+    EXPECT_EQ(limit_analysis(m, 0.8, 9.81, true, options).status, "infeasible") << right_toe;
+  }
+}
+
 TEST(LimitBlock, IndependentOfGravityDensityAndThickness) {
   Model m = case_model("block");
   const double ref = limit_analysis(m, 0.8, 9.81, false).lambda_la;

@@ -1,9 +1,11 @@
 // Supports that move ([supports], core/supports.hpp): the ramp, moved rigid and elastic
 // supports reaching their pose exactly with the energy ledger balanced, the deck's refusals
 // (exit status 2 naming key and value), model.fixed on generated scenes, limit analysis of the
-// moved blocks, the supports' acceptance check (the semicircular arch, rigid blocks, with its
+// moved blocks, the supports' acceptance checks (the semicircular arch, rigid blocks, with its
 // supports spread apart carries the least thrust of limit analysis, pushed together the
-// greatest), and the spreading study (drivers/spread.hpp) and its command.
+// greatest; spread by 1% of its span, its lambda* lies between the limit analyses with the
+// open joints as points and closed, and at the peak of its pushover), and the spreading study
+// (drivers/spread.hpp) and its command.
 
 #include <gtest/gtest.h>
 
@@ -166,6 +168,60 @@ TEST(SupportsAcceptance, SpreadArchCarriesTheLeastThrustPushedTheGreatest) {
         s.wall_s);
     EXPECT_NEAR(h, la.thrust, 0.03 * la.thrust) << d;
   }
+}
+
+// The acceptance of a moved structure (docs/supports.md "The acceptance"): the arch spread by
+// 1% of its 2 m span (each abutment 10 mm out), its FDEM lambda* (`capacity`) lies between
+// limit analysis of the moved blocks with the open joints as point contacts at their pivots
+// (`limit --open-joints points`) and with every joint closed (`limit`), and within 2% of the
+// peak of a pushover of the moved arch. The pushover ends at 12 mm of the crown (capacity's
+// collapse displacement, 5% of L_ref), past its peak near 5 mm (the peak must lie before the
+// end: its last point has fallen below it). The figures, run through the program as the table
+// of docs/supports.md gives them.
+TEST(SupportsAcceptance, SpreadArchLambdaStarLiesBetweenTheTwoLimitAnalysesAndAtThePushoverPeak) {
+  const std::string dir = ::testing::TempDir();
+  const std::string moves = "supports.moves=[{block = 11, dx = -0.01}, {block = 12, dx = 0.01}]";
+  auto run = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {
+        VOUSSOIR_BINARY, extra[0], case_path("circular_arch"), "--quiet", "--set",
+        moves,           "--json", dir + name + ".json"};
+    args.insert(args.end(), extra.begin() + 1, extra.end());
+    const testing::ProcessResult p =
+        testing::run_process(args, {.wall_s = 300, .cpu_s = 600}, dir + name);
+    EXPECT_TRUE(p.exited && p.status == 0) << name << ": " << p.describe() << p.err;
+    return nlohmann::json::parse(testing::read_text_file(dir + name + ".json"));
+  };
+  const nlohmann::json points = run("la_points", {"limit", "--open-joints", "points"});
+  const nlohmann::json closed = run("la_closed", {"limit"});
+  const nlohmann::json fdem = run("capacity", {"capacity"});
+  const nlohmann::json push = run("pushover", {"pushover", "--max-displacement", "0.012"});
+  ASSERT_EQ(points.at("status"), "optimal");
+  ASSERT_EQ(closed.at("status"), "optimal");
+  EXPECT_EQ(points.at("open_joints"), "points");
+  EXPECT_EQ(closed.at("open_joints"), "closed");
+  EXPECT_TRUE(closed.at("point_contacts").empty());
+  EXPECT_FALSE(points.at("point_contacts").empty());
+  const double lower = points.at("lambda_la"), upper = closed.at("lambda_la");
+  const double lambda_star = fdem.at("lambda_star");
+  const double peak = push.at("peak").at("lambda");
+  const nlohmann::json& curve = push.at("curve");
+  ASSERT_FALSE(curve.empty());
+  EXPECT_LT(curve.back().at("lambda").get<double>(), peak) << "the pushover ended at its peak";
+  std::printf(
+      "spread 1%%: LP (points) %.2g, FDEM lambda* %.5f, LP (closed) %.5f, pushover peak %.5f "
+      "(lambda* / peak - 1 = %+.2f%%); %zu joints taken as points\n",
+      lower, lambda_star, upper, peak, 100.0 * (lambda_star / peak - 1.0),
+      points.at("point_contacts").size());
+  EXPECT_LE(lower, lambda_star);
+  EXPECT_LE(lambda_star, upper);
+  EXPECT_NEAR(lambda_star, peak, 0.02 * peak);
+  // Without moved supports the blocks stand as built: no joint to take as a point.
+  const testing::ProcessResult refused = testing::run_process(
+      {VOUSSOIR_BINARY, "limit", case_path("circular_arch"), "--quiet", "--open-joints", "points"},
+      {}, dir + "la_refused");
+  EXPECT_TRUE(refused.exited && refused.status == 2) << refused.describe();
+  EXPECT_NE(refused.err.find("--open-joints points needs [supports] moves"), std::string::npos)
+      << refused.err;
 }
 
 // The spreading study (drivers/spread.hpp) on the same arch, its left support moved out in
