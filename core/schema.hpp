@@ -68,6 +68,11 @@ struct MeshConfig {
   // Rigid blocks (mesh/minimal.hpp): an outline point goes when the chord replacing it stays
   // within this fraction of the block's thickness of the outline.
   double chord_tolerance = 0.01;
+  // The most triangles a model may have: a scene whose estimate is above it is refused before
+  // it is meshed, a block whose mesh grows past it while being meshed, and a finished mesh
+  // above it (mesh/scene.cpp). 4e6 triangles take about 1.6 GB (390 B each, docs/performance.md)
+  // and half a minute of meshing.
+  int max_triangles = 4000000;
 };
 
 struct MaterialConfig {

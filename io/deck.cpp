@@ -338,6 +338,7 @@ const std::vector<KeySpec>& key_table() {
       {"model.out_of_plane", [](Reader& r, const toml::node& n, Config& c) { c.model.out_of_plane = r.number(n, above(0), "m"); }},
       // [mesh]
       {"mesh.chord_tolerance", [](Reader& r, const toml::node& n, Config& c) { c.mesh.chord_tolerance = r.number(n, {0, false, 1, false}, "x the block's thickness (rigid blocks)"); }},
+      {"mesh.max_triangles", [](Reader& r, const toml::node& n, Config& c) { c.mesh.max_triangles = r.integer(n, 1, 1000000000); }},
       {"mesh.size", [](Reader& r, const toml::node& n, Config& c) { c.mesh.size = r.number(n, at_least(0), "m, 0 = use mesh.through_thickness"); }},
       {"mesh.through_thickness", [](Reader& r, const toml::node& n, Config& c) { c.mesh.through_thickness = r.integer(n, 1, 1000); }},
       // [material]

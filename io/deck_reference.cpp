@@ -61,6 +61,9 @@ const std::map<std::string, std::string>& meanings() {
       {"mesh.chord_tolerance",
        "rigid blocks: an outline point is dropped when its chord stays within this fraction of "
        "the block's thickness"},
+      {"mesh.max_triangles",
+       "the most triangles a model may have; a deck whose mesh would exceed it is refused "
+       "(exit 2) before or while it is meshed"},
       {"mesh.size", "target element size (0: from mesh.through_thickness)"},
       {"mesh.through_thickness", "elements across the arch thickness (or the smallest block)"},
       // [material]
@@ -203,6 +206,7 @@ std::string default_of(const std::string& key) {
       {"model.fixed", list(m.fixed, [](int v) { return std::to_string(v); })},
       {"model.out_of_plane", number(m.out_of_plane)},
       {"mesh.chord_tolerance", number(c.mesh.chord_tolerance)},
+      {"mesh.max_triangles", std::to_string(c.mesh.max_triangles)},
       {"mesh.size", number(c.mesh.size)},
       {"mesh.through_thickness", std::to_string(c.mesh.through_thickness)},
       {"material.density", number(c.material.density)},

@@ -21,24 +21,18 @@ namespace voussoir {
 
 namespace {
 
-// Largest mesh the generators agree to build: beyond it a typing slip in mesh.size would
-// exhaust memory before the user sees anything.
-constexpr double kMaxTriangles = 4e6;
-
 // The mesh of one polygon block is refused once it grows past this many times the estimate of
 // the triangle budget (5 area / size^2), plus a floor for small blocks: a quality mesh grows far
 // beyond its area's share only where the outline is much thinner than the element size (a
 // sliver, a needle corner, a narrow slot), and there it may not stop (docs/robustness.md, "Open
-// findings"). The largest polygon block of a shipped deck uses 8% of its cap.
+// findings"). The largest polygon block of a shipped deck uses 8% of its cap. Never above
+// mesh.max_triangles.
 constexpr double kPolygonMeshSlack = 10.0;
 constexpr double kPolygonMeshFloor = 1e4;
 
-std::size_t polygon_mesh_cap(const BlockSpec& b) {
-  if (b.mesher != BlockSpec::Mesher::Polygon && b.mesher != BlockSpec::Mesher::SymmetricPolygon)
-    return 0;
+double polygon_mesh_slack_cap(const BlockSpec& b) {
   const double estimate = 5.0 * std::abs(outline_area(b.outline)) / (b.size * b.size);
-  return static_cast<std::size_t>(
-      std::min(kPolygonMeshSlack * estimate + kPolygonMeshFloor, kMaxTriangles));
+  return kPolygonMeshSlack * estimate + kPolygonMeshFloor;
 }
 
 std::string format_number(double v) {
@@ -86,10 +80,11 @@ void choose_band_cells(double t, double length, double curvature_ratio, double h
 }
 
 void check_triangle_budget(const SceneParams& params, double estimate) {
-  if (estimate <= kMaxTriangles) return;
+  if (estimate <= params.mesh.max_triangles) return;
   std::ostringstream why;
-  why << "would make about " << static_cast<long long>(estimate) << " triangles (limit "
-      << static_cast<long long>(kMaxTriangles) << "); use a coarser mesh";
+  why << "would make about " << static_cast<long long>(estimate)
+      << " triangles (limit mesh.max_triangles = " << params.mesh.max_triangles
+      << "); use a coarser mesh";
   if (params.mesh.size > 0.0) geometry_error(params, "mesh.size", params.mesh.size, why.str());
   geometry_error(params, "mesh.through_thickness", params.mesh.through_thickness, why.str());
 }
@@ -135,9 +130,13 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
   check_triangle_budget(params, estimate);
 
   // Mesh every block that is not a mirror first, then the mirrors.
+  const double limit = params.mesh.max_triangles;
   for (std::size_t i = 0; i < scene.blocks.size(); ++i) {
     BlockSpec& b = scene.blocks[i];
-    const std::size_t cap = polygon_mesh_cap(b);
+    const bool polygon =
+        b.mesher == BlockSpec::Mesher::Polygon || b.mesher == BlockSpec::Mesher::SymmetricPolygon;
+    const double slack_cap = polygon ? polygon_mesh_slack_cap(b) : 0.0;
+    const std::size_t cap = polygon ? static_cast<std::size_t>(std::min(slack_cap, limit)) : 0;
     try {
       switch (b.mesher) {
         case BlockSpec::Mesher::Band:
@@ -153,6 +152,14 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
         case BlockSpec::Mesher::Given:
           break;
       }
+    } catch (const MeshTooLarge& e) {
+      if (slack_cap < limit)
+        throw std::runtime_error("block " + std::to_string(i) + ": " + e.what() +
+                                 ": the outline is far thinner than the element size somewhere "
+                                 "(a sliver, a needle corner or a narrow slot)");
+      geometry_error(params, "mesh.max_triangles", params.mesh.max_triangles,
+                     "block " + std::to_string(i) + ": " + e.what() +
+                         "; use a coarser mesh or raise mesh.max_triangles");
     } catch (const std::exception& e) {
       // The block is named in build_model's report; a deck error and a mesh that does not fit
       // in memory keep their own reports there.
@@ -172,6 +179,16 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
 
   if (scene.rotation != 0.0)
     for (BlockSpec& b : scene.blocks) rotate_mesh(b.mesh, scene.rotation);
+
+  // The estimates above are approximate (a long thin fixed block meshes finer than its area
+  // says): the finished mesh is held to the limit too, before a model is built from it.
+  std::size_t triangles = 0;
+  for (const BlockSpec& b : scene.blocks) triangles += b.mesh.tris.size();
+  if (static_cast<double>(triangles) > limit)
+    geometry_error(params, "mesh.max_triangles", params.mesh.max_triangles,
+                   "the mesh has " + std::to_string(triangles) +
+                       " triangles, more than the limit; use a coarser mesh or raise "
+                       "mesh.max_triangles");
 
   if (scene.check_overlaps) {
     // User-drawn blocks must not overlap: compare every pair whose boxes meet.

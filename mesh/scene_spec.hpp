@@ -88,7 +88,9 @@ struct Scene {
 Scene build_scene(const SceneParams& params);
 
 // Meshes every block of the scene, builds the Model (material, out_of_plane, joints) and
-// finalizes it. Fills BlockSpec::mesh of every block.
+// finalizes it. Fills BlockSpec::mesh of every block. Throws DeckError naming
+// mesh.max_triangles when the scene's estimate, one block's mesh while it is refined, or the
+// finished mesh exceeds it.
 Model mesh_scene(Scene& scene, const SceneParams& params);
 
 // Point of the centreline at arc length s from the left springing.
@@ -139,8 +141,9 @@ Scene build_polygons_scene(const SceneParams& params);  // polygons
 double element_size(const SceneParams& params, double reference);
 
 // Throws DeckError naming mesh.size (or mesh.through_thickness) when a mesh of about
-// `estimate` triangles would exceed the generators' limit (4e6). Generators call it before
-// allocating a structured mesh.
+// `estimate` triangles would exceed mesh.max_triangles. Generators call it before allocating a
+// structured mesh; mesh_scene calls it for the whole scene and holds each polygon block, and
+// the finished mesh, to the same limit.
 void check_triangle_budget(const SceneParams& params, double estimate);
 
 // Throws DeckError "<deck>: model.<key> = <value>: <why>".

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
 
 #include "mesh/scene_spec.hpp"
 
@@ -25,6 +26,15 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kFixedCoarsening = 3.0;
+// Tallest stack (stack x height) accepted, in block widths. The ground is width / 2 deep and
+// reaches 1.5 width + stack x height to each side, so a tall stack on a narrow base makes a
+// long thin ground strip, whose quality mesh (CGAL) refines down to its depth along its whole
+// length and slows superlinearly with that length. Measured with the block deck
+// (`check`, CPU seconds, mesh.through_thickness 1): 2000 widths (stack 1000 of the shipped
+// blocks) 0.3 s; 6000: refused by the runaway cap of mesh_scene after 0.5 s, but meshed with
+// through_thickness 2 and 4 in 2.6 s and 10 s (88 000 and 272 000 triangles); 20 000: refused
+// after 7 s; 60 000 after 76 s; 200 000 (height 1e5, a fuzzing input) not done in 16 minutes.
+constexpr double kMaxStackToWidth = 2000.0;
 
 Vec2 rotate(Vec2 p, double c, double s) {
   return {c * p.x - s * p.y, s * p.x + c * p.y};
@@ -43,6 +53,17 @@ Scene build_block_scene(const SceneParams& params) {
   if (stack < 1) geometry_error(params, "model.stack", stack, "expected at least 1 block");
   if (!(incline >= 0.0 && incline < 90.0))
     geometry_error(params, "model.incline", incline, "expected an angle in [0, 90) degrees");
+  if (stack * ht > kMaxStackToWidth * w) {
+    std::ostringstream why;
+    why << "a stack of " << stack << " block(s) " << ht << " m tall (model.stack x model.height) "
+        << "on a base " << w << " m wide (model.width) is " << stack * ht / w
+        << " times taller than wide (at most " << kMaxStackToWidth
+        << "): the ground the scene lays under it would reach " << 1.5 * w + stack * ht
+        << " m to each side and be " << 0.5 * w
+        << " m deep, a strip whose mesh takes seconds to hours; use a wider base, lower blocks "
+           "or fewer";
+    geometry_error(params, "model.height", ht, why.str());
+  }
 
   const double h = element_size(params, std::min(w, ht));
   int n = 1, m = 1;  // n rows up the height, m columns across the width

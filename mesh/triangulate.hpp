@@ -20,6 +20,7 @@
 // CGAL is confined to mesh/triangulate_cgal.cpp (it compiles slowly).
 
 #include <array>
+#include <stdexcept>
 #include <vector>
 
 #include "core/model.hpp"
@@ -34,8 +35,13 @@ struct TriMesh {
 // Structured mesh of a band of (m + 1) columns of (n + 1) nodes each (m, n >= 1).
 TriMesh mesh_band(const std::vector<std::vector<Vec2>>& columns);
 
+// A triangulation that grew past its `max_triangles` (the caller says why that bound was set).
+struct MeshTooLarge : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // Quality mesh of a simple counter-clockwise polygon; `size` bounds the longest edge [m].
-// Throws std::invalid_argument if the polygon is not simple, and std::runtime_error once the
+// Throws std::invalid_argument if the polygon is not simple, and MeshTooLarge once the
 // triangulation grows past `max_triangles` (0: no limit; the count includes the faces
 // between the polygon and its convex hull, and one per hull edge).
 TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size,

@@ -124,8 +124,8 @@ TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size,
   for (std::size_t i = 0; i < nb; ++i) cdt.insert_constraint(input[i], input[(i + 1) % nb]);
 
   // Refine one point at a time, so that an outline much thinner than `size` somewhere (a
-  // sliver, a needle corner, a narrow slot), whose quality mesh grows without bound there, is
-  // refused at the budget instead of meshed for minutes.
+  // sliver, a needle corner, a narrow slot), whose quality mesh grows without bound there, or
+  // a mesh larger than the deck allows, is refused at the budget instead of meshed for minutes.
   Mesher mesher(cdt, Criteria(kShapeBound, size));
   mesher.init();
   while (!mesher.is_refinement_done()) {
@@ -135,9 +135,8 @@ TriMesh triangulate_polygon(const std::vector<Vec2>& boundary, double size,
     if (max_triangles > 0 && cdt.tds().number_of_faces() > max_triangles) {
       std::ostringstream why;
       why << "its quality mesh at element size " << size << " m exceeds " << max_triangles
-          << " triangles: the outline is far thinner than the element size somewhere (a sliver,"
-             " a needle corner or a narrow slot)";
-      throw std::runtime_error(why.str());
+          << " triangles";
+      throw MeshTooLarge(why.str());
     }
   }
 

@@ -53,6 +53,7 @@ out_of_plane = 0.092
 size = 0.05
 through_thickness = 3
 chord_tolerance = 0.02
+max_triangles = 250000
 
 [material]
 density = 450
@@ -179,6 +180,7 @@ TEST(Deck, FullDeckRoundTripsIntoConfig) {
   EXPECT_DOUBLE_EQ(c.mesh.size, 0.05);
   EXPECT_EQ(c.mesh.through_thickness, 3);
   EXPECT_DOUBLE_EQ(c.mesh.chord_tolerance, 0.02);
+  EXPECT_EQ(c.mesh.max_triangles, 250000);
   EXPECT_DOUBLE_EQ(c.material.density, 450.0);
   EXPECT_DOUBLE_EQ(c.material.young, 3.5e9);
   EXPECT_DOUBLE_EQ(c.material.poisson, 0.25);
@@ -438,6 +440,10 @@ TEST(DeckErrors, FloatWhereIntegerRequired) {
                     {"deck.toml:3:", "model.voussoirs = 11.0", "an integer"});
   expect_deck_error(std::string(kMinimal) + "[mesh]\nthrough_thickness = 2.5\n",
                     {"mesh.through_thickness = 2.5", "an integer"});
+  expect_deck_error(std::string(kMinimal) + "[mesh]\nmax_triangles = 100.5\n",
+                    {"mesh.max_triangles = 100.5", "an integer in [1, 1000000000]"});
+  expect_deck_error(std::string(kMinimal) + "[mesh]\nmax_triangles = 0\n",
+                    {"mesh.max_triangles = 0", "an integer in [1, 1000000000]"});
   expect_deck_error(std::string(kMinimal) + "fixed = [0, 1.0]\n",
                     {"model.fixed = [0, 1.0]", "integers"});
 }

@@ -560,6 +560,10 @@ TEST(Scenes, GeometryErrorsNameTheKey) {
        "model.base_depth", "below"},
       {"[model]\nkind = \"church\"\npier_width = 0.9\n", "model.pier_width", "two springings"},
       {"[model]\nkind = \"church\"\nouter_width = 0.4\n", "model.outer_width", "springing"},
+      {"[model]\nkind = \"block\"\nheight = 100000\n", "model.height = 100000",
+       "200000 times taller than wide (at most 2000)"},
+      {"[model]\nkind = \"block\"\nwidth = 0.0001\n", "model.width",
+       "10000 times taller than wide (at most 2000)"},
       {"[model]\nkind = \"circular_arch\"\n[mesh]\nsize = 1e-5\n", "mesh.size", "triangles"},
       {"[model]\nkind = \"polygons\"\nfile = \"two_blocks.txt\"\nfixed = [2]\n", "model.fixed",
        "2 blocks"},
@@ -581,6 +585,56 @@ TEST(Scenes, GeometryErrorsNameTheKey) {
   SceneParams c = make_deck(arch_deck("circular_arch", 180.0));
   c.model.voussoirs = 0;
   EXPECT_THROW(build_model(c), DeckError);
+}
+
+// mesh.max_triangles holds at the three places mesh_scene checks it: the scene's estimate
+// before meshing, a polygon block while its quality mesh is refined, and the finished mesh.
+// The block deck makes 24 triangles (12 estimated: the ground is a thin strip, meshed finer
+// than its area says); a polygon ground 20 m long and 1 cm deep makes 2594 with the default
+// limit; 1 mm deep, it runs past the runaway cap of its block (10 x its estimate + 1e4) and is
+// refused as an outline far thinner than the element size, as before the key existed.
+TEST(Scenes, MeshMaxTrianglesHoldsBeforeWhileAndAfterMeshing) {
+  const std::string block = "[model]\nkind = \"block\"\n[mesh]\nmax_triangles = ";
+  auto refusal = [](const std::string& deck) {
+    try {
+      const Model m = build_model(make_deck(deck));
+      return "accepted, " + std::to_string(m.tris.size()) + " triangles";
+    } catch (const DeckError& e) {
+      return std::string(e.what());
+    }
+  };
+  EXPECT_EQ(build_model(make_deck(block + "24\n")).tris.size(), 24);
+  EXPECT_NE(
+      refusal(block + "10\n").find("would make about 12 triangles (limit mesh.max_triangles = 10)"),
+      std::string::npos)
+      << refusal(block + "10\n");
+  EXPECT_NE(refusal(block + "23\n").find("mesh.max_triangles = 23: the mesh has 24 triangles"),
+            std::string::npos)
+      << refusal(block + "23\n");
+
+  const std::string dir = ::testing::TempDir();
+  auto strip = [&](const std::string& depth, const std::string& limit) {
+    const std::string file = dir + "voussoir_strip_" + depth + ".txt";
+    std::FILE* f = std::fopen(file.c_str(), "w");
+    std::fprintf(
+        f, "block\n-0.25 0\n0.25 0\n0.25 0.5\n-0.25 0.5\nblock\n-10 -%s\n10 -%s\n10 0\n-10 0\n",
+        depth.c_str(), depth.c_str());
+    std::fclose(f);
+    const std::string r = refusal("[model]\nkind = \"polygons\"\nfile = \"" + file +
+                                  "\"\nfixed = [1]\n[mesh]\nmax_triangles = " + limit + "\n");
+    std::remove(file.c_str());
+    return r;
+  };
+  EXPECT_EQ(strip("0.01", "4000000"), "accepted, 2594 triangles");
+  const std::string capped = strip("0.01", "1000");
+  EXPECT_NE(capped.find("mesh.max_triangles = 1000: block 1: its quality mesh at element size "
+                        "2.12132 m exceeds 1000 triangles"),
+            std::string::npos)
+      << capped;
+  const std::string thin = strip("0.0001", "4000000");
+  EXPECT_NE(thin.find("exceeds 10000 triangles: the outline is far thinner"), std::string::npos)
+      << thin;
+  EXPECT_EQ(thin.find("mesh.max_triangles"), std::string::npos) << thin;
 }
 
 TEST(Scenes, ShippedDecksLoadAndMeshWell) {
