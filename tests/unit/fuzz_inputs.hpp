@@ -12,6 +12,11 @@
 //          runnable, e.g. lambda = 1e300);
 //   never a signal (crash, abort, sanitizer report), never the time limit (hang), never the
 //   memory limit (std::bad_alloc would surface as exit 1 without a step: refused as well).
+// The work of an input is bounded by counts, so that a loaded machine never decides an outcome:
+// every command gets mesh.max_triangles = kFuzzMaxTriangles (a mutation that makes a larger mesh
+// is refused by name, exit 2, before or while it is meshed) and `run` gets --max-steps
+// kFuzzMaxSteps (a run still going then fails naming the step, exit 1). The wall-clock limit
+// stays, as the net for a hang.
 // Every failing input is kept under <tmp>/voussoir_fuzz_failures/ with a line to reproduce it.
 
 #include <gtest/gtest.h>
@@ -31,6 +36,17 @@
 namespace voussoir::testing {
 
 namespace fuzz_fs = std::filesystem;
+
+// The shipped decks have 24 to 630 triangles and take 1e-4 s in 3 to 200 steps; a mutation
+// that scales the mesh (mesh.through_thickness = 3) stays far below these bounds. Above them:
+// `check` of a 1.7 million triangle block (model.width = 2000, a swap of two values) took 15 to
+// 30 s of a 20 s limit on a loaded machine, and a rigid church with a 1e4 times smaller step
+// (material.density = 1e-4) ran 1e6 steps for minutes. At the bounds: meshing 20 000
+// triangles, or a block's runaway quality mesh stopped there, takes under a second; 5000 steps
+// of 20 000 triangles are 1e8 triangle-steps, about 3 s at the 28 ns a triangle-step of the
+// elastic block measured on this machine.
+inline constexpr int kFuzzMaxTriangles = 20000;
+inline constexpr int kFuzzMaxSteps = 5000;
 
 inline std::string source_path(const std::string& rel) {
   return std::string(VOUSSOIR_SOURCE_DIR) + "/" + rel;
@@ -357,15 +373,19 @@ inline void fuzz_one(const std::string& command, const std::string& deck_path,
                      const std::string& what, FuzzTally& tally, const std::string& label,
                      const std::string& extra_file = "") {
   const std::string dir = fuzz_fs::path(deck_path).parent_path().string();
-  std::vector<std::string> args = {VOUSSOIR_BINARY, command, deck_path, "-q"};
-  // A sane deck checks in well under a second and runs 1e-4 s in about one; 20 and 40 s leave
-  // room for a loaded machine and sanitizer builds.
+  std::vector<std::string> args = {
+      VOUSSOIR_BINARY, command,
+      deck_path,       "-q",
+      "--set",         "mesh.max_triangles=" + std::to_string(kFuzzMaxTriangles)};
+  // Within the bounds above an input checks in under a second and runs in a few; 20 and 40 s
+  // leave room for a loaded machine and sanitizer builds.
   Limits limits;
   limits.wall_s = command == "run" ? 40 : 20;
   limits.cpu_s = 2 * limits.wall_s;
   if (command == "run") {
     // A short end time, whatever the deck says; output into the scratch folder.
-    args.insert(args.end(), {"--set", "solver.end_time=1e-4", "-o", dir + "/fuzz_run.h5"});
+    args.insert(args.end(), {"--set", "solver.end_time=1e-4", "--max-steps",
+                             std::to_string(kFuzzMaxSteps), "-o", dir + "/fuzz_run.h5"});
   }
   const ProcessResult r = run_process(args, limits, dir + "/child");
   ++tally.inputs;

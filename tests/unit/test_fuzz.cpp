@@ -163,7 +163,8 @@ TEST(FuzzFindings, ChurchHugeOuterWidth) {
 // mesh/scenes_church.cpp: supports of 5e-324 m (or 1e-6 m) were outlined into ever more course
 // slivers and `check` never finished (slow fuzz tier).
 TEST(FuzzFindings, ChurchTinyHeight) {
-  for (const std::string& set : {std::string("model.height=5e-324"), std::string("model.height=1e-6")}) {
+  for (const std::string& set :
+       {std::string("model.height=5e-324"), std::string("model.height=1e-6")}) {
     expect_refused_naming(check_with("church_a.toml", {set}),
                           {"at least 0.01 x the largest span (6 m)"}, set + ": ");
   }
@@ -215,6 +216,31 @@ TEST(FuzzFindings, PolygonNeedleCorner) {
       check_polygons("block\n-0.25 0\n0.25 0\n0.25 1\n0.0005 1\n0 0.001\n-0.0005 1\n-0.25 1\n"
                      "block\n-1.75 -0.25\n1.75 -0.25\n1.75 0\n-1.75 0\n"),
       {"blocks.txt:6: block 0: the corner at vertex (0, 0.001) is a notch of"});
+}
+
+// mesh/scenes_block.cpp: a block 1e5 m tall on its 0.5 m base (or 1 m tall on a 0.1 mm base)
+// lays a ground strip 1e5 m long and 0.25 m deep (or 1 m and 50 micrometres) under it, whose
+// quality mesh runs past the runaway cap only after hours (seconds): `check` hit the time limit
+// (slow fuzz tier). Now refused up front, naming the height and the ratio; the tallest stack
+// the key range allows on the shipped blocks (1000 blocks, 2000 widths) is still accepted.
+TEST(FuzzFindings, BlockTallStackOnANarrowBase) {
+  expect_refused_naming(check_with("block.toml", {"model.height=100000"}),
+                        {"model.height = 100000", "200000 times taller than wide (at most 2000)"});
+  expect_refused_naming(check_with("block.toml", {"model.width=0.0001"}),
+                        {"0.0001 m wide (model.width)", "10000 times taller than wide"});
+  const ProcessResult ok = check_with("block.toml", {"model.stack=1000"});
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.describe() << "\n" << ok.err;
+}
+
+// mesh/scene.cpp: the block deck with width and density swapped (width 2000 m, slow fuzz tier)
+// is a valid deck of 1.7 million triangles, whose `check` took 15 to 30 s against the fuzz's
+// 20 s limit on a loaded machine. Under the fuzz's mesh.max_triangles (fuzz_inputs.hpp) it is
+// refused before it is meshed, naming the limit.
+TEST(FuzzFindings, BlockWideBaseUnderTheFuzzTriangleLimit) {
+  expect_refused_naming(
+      check_with("block.toml", {"model.width=2000", "material.density=0.5",
+                                "mesh.max_triangles=" + std::to_string(kFuzzMaxTriangles)}),
+      {"would make about 1675226 triangles (limit mesh.max_triangles = 20000)"});
 }
 
 // mesh/scenes_arch.cpp (or io/deck.cpp ranges): embrace 0.092 degrees with 13 voussoirs of a
