@@ -17,14 +17,16 @@ namespace voussoir {
 namespace {
 // The cone solve (nscd.hpp "Cone solve"): taken after every this many sweeps without
 // convergence; at most this many products with the Delassus operator W in one cone solve, and
-// this many passes of Tresca's box (the sweeps that follow settle the friction); a Newton step on
-// the free face every this many products; the regularisation of the face's matrix (its diagonal is
-// 1), which keeps redundant contacts definite (with 1e-10 the Newton steps ran off along the
-// redundancy and the descent test refused 7 to 9 in 10 of them; 1e-3 slowed the steps towards
-// the solution: church_b's capacity took 9 times as long).
+// this many passes of Tresca's box (a pass stops them when mu r_n moves the box by less than the
+// tolerance; with 2 passes the friction was often left unsettled, the sweeps returned to the
+// same impulses and 9 steps in 6000 of church_b under a record stopped at the cap, with 4 and
+// 16 about one); a Newton step on the free face every this many products; the regularisation of the
+// face's matrix (its diagonal is 1), which keeps redundant contacts definite (with 1e-10 the Newton
+// steps ran off along the redundancy and the descent test refused 7 to 9 in 10 of them; 1e-3 slowed
+// the steps towards the solution: church_b's capacity took 9 times as long).
 constexpr int kSweepsBeforeCone = 20;
 constexpr int kConeProducts = 3000;
-constexpr int kTrescaPasses = 2;
+constexpr int kTrescaPasses = 16;
 constexpr int kNewtonEvery = 10;
 constexpr double kFaceRegularisation = 1e-6;
 // Power iterations for the largest eigenvalue of W (the projections' step), and its margin
@@ -609,6 +611,9 @@ struct FaceScratch {
   Eigen::SimplicialLDLT<FaceMatrix, Eigen::Upper, Eigen::NaturalOrdering<Eigen::Index>> ldlt;
   Eigen::VectorXd rhs, x;
   bool analysed = false;
+  // The face whose factors ldlt holds (empty: none). A face met again in the same cone solve
+  // (a later pass of Tresca's box keeps the face more often than not) reuses them.
+  std::vector<char> factored_face;
 };
 thread_local FaceScratch t_face;
 
@@ -688,6 +693,7 @@ void NscdContact::assemble_cone_matrix(const std::vector<double>& inv,
     w.entry_row[std::size_t(fill[body]++)] = {sign * dir.x, sign * dir.y,
                                               sign * (rx * dir.y - ry * dir.x)};
   });
+  w.factored_face.clear();
   // A = sum over the bodies of row_i M^-1 row_j.
   w.values.assign(std::size_t(w.a.nonZeros()), 0.0);
   std::size_t pair = 0;
@@ -704,12 +710,13 @@ void NscdContact::assemble_cone_matrix(const std::vector<double>& inv,
   }
 }
 
-bool NscdContact::face_step(const std::vector<double>& s, const std::vector<char>& free,
-                            const std::vector<double>& g, std::vector<double>& d) const {
+namespace {
+// Factors A_FF for the face on_face(i) into t_face.ldlt; false when the face is empty or does
+// not factor.
+template <class OnFace>
+bool factor_face(Eigen::Index m, const OnFace& on_face) {
   FaceScratch& w = t_face;
-  const Eigen::Index m = Eigen::Index(2 * points_.size());
-  std::fill(d.begin(), d.end(), 0.0);
-  auto on_face = [&](Eigen::Index i) { return free[std::size_t(i)] && s[std::size_t(i)] > 0.0; };
+  w.factored_face.clear();
   // A_FF with the regularisation on the free face; an identity row and column elsewhere (they
   // change nothing of the face's factors).
   bool any = false;
@@ -735,6 +742,22 @@ bool NscdContact::face_step(const std::vector<double>& s, const std::vector<char
   }
   w.ldlt.factorize(w.a);
   if (w.ldlt.info() != Eigen::Success) return false;
+  w.factored_face.resize(std::size_t(m));
+  for (Eigen::Index i = 0; i < m; ++i) w.factored_face[std::size_t(i)] = char(on_face(i));
+  return true;
+}
+}  // namespace
+
+bool NscdContact::face_step(const std::vector<double>& s, const std::vector<char>& free,
+                            const std::vector<double>& g, std::vector<double>& d) const {
+  FaceScratch& w = t_face;
+  const Eigen::Index m = Eigen::Index(2 * points_.size());
+  std::fill(d.begin(), d.end(), 0.0);
+  auto on_face = [&](Eigen::Index i) { return free[std::size_t(i)] && s[std::size_t(i)] > 0.0; };
+  bool same = w.factored_face.size() == std::size_t(m);
+  for (Eigen::Index i = 0; same && i < m; ++i)
+    same = w.factored_face[std::size_t(i)] == char(on_face(i));
+  if (!same && !factor_face(m, on_face)) return false;
   w.rhs.resize(m);
   for (Eigen::Index i = 0; i < m; ++i) w.rhs[i] = on_face(i) ? -g[std::size_t(i)] : 0.0;
   w.x = w.ldlt.solve(w.rhs);
