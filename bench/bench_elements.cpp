@@ -15,7 +15,7 @@
 #include "bench/wall.hpp"
 #include "core/cst.hpp"
 #include "core/integrate.hpp"
-#include "core/step.hpp"
+#include "engine/step.hpp"
 
 namespace {
 

@@ -25,7 +25,7 @@
 #include "core/cst.hpp"
 #include "core/integrate.hpp"
 #include "core/ordering.hpp"
-#include "drivers/setup.hpp"
+#include "engine/setup.hpp"
 #include "io/deck.hpp"
 
 using namespace voussoir;

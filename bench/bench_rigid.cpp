@@ -1,10 +1,10 @@
 // One explicit step of the shipped churches with rigid blocks (cases/church_b.toml: 236 blocks,
 // monolithic supports; cases/church_a.toml: 315 blocks, supports of courses), one thread, after
 // a gravity settle of 20 000 steps (joints in contact, the candidate list of a structure at
-// rest; undamped joints), with the stage split of core/step.hpp (StageTimers) as counters in microseconds per
-// step. As in the engine's runs, the joints' elastic energy is computed at the steps whose
-// ledger is read (the samples, one step in hundreds): `/energy:0`; `/energy:1` computes it at
-// every step.
+// rest; undamped joints), with the stage split of engine/step.hpp (StageTimers) as counters in
+// microseconds per step. As in the engine's runs, the joints' elastic energy is computed at the
+// steps whose ledger is read (the samples, one step in hundreds): `/energy:0`; `/energy:1` computes
+// it at every step.
 //
 // Run: OMP_NUM_THREADS=1 build/bench_rigid
 // Figures: the time per step, us_contact, us_integrate, ..., the touching pairs (active).
@@ -13,8 +13,8 @@
 #include <string>
 
 #include "bench/timed_steps.hpp"
-#include "core/step.hpp"
-#include "drivers/setup.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
 #include "io/deck.hpp"
 
 using namespace voussoir;

@@ -13,8 +13,8 @@
 #include <string>
 
 #include "bench/timed_steps.hpp"
-#include "core/step.hpp"
-#include "drivers/setup.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
 #include "io/deck.hpp"
 
 using namespace voussoir;

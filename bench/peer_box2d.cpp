@@ -50,7 +50,7 @@
 #include <utility>
 #include <vector>
 
-#include "drivers/setup.hpp"
+#include "engine/setup.hpp"
 #include "io/deck.hpp"
 #include "mesh/minimal.hpp"
 

@@ -3,7 +3,7 @@
 // but not stopping the run -- with a time series on stdout: kinetic energy, largest node speed,
 // largest block motion, the ledger's external work and friction / local / impact dissipation,
 // and for chosen joints the slip, the openings at both ends and the joint resultants N, V and
-// |V| / (mu N) (drivers/thrust.hpp). At the end: block motions, every joint's state and, with
+// |V| / (mu N) (engine/thrust.hpp). At the end: block motions, every joint's state and, with
 // --avg-from, time averages of the joint resultants and of each free block's residual
 // (joint forces + weight + lambda weight: zero for a block in static equilibrium; in a steady
 // creep it is the mean force that something else -- the local damping -- supplies).
@@ -32,10 +32,10 @@
 #include <string>
 #include <vector>
 
-#include "drivers/capacity.hpp"
-#include "drivers/kinematics.hpp"
-#include "drivers/thrust.hpp"
-#include "drivers/trial.hpp"
+#include "commands/capacity.hpp"
+#include "engine/kinematics.hpp"
+#include "engine/thrust.hpp"
+#include "engine/trial.hpp"
 #include "io/deck.hpp"
 
 using namespace voussoir;

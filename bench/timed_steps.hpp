@@ -1,9 +1,9 @@
 #pragma once
 // The timed loop of the step benchmarks: advance() once per benchmark iteration with the stage
-// timers of core/step.hpp on (reset first); returns the steps taken.
+// timers of engine/step.hpp on (reset first); returns the steps taken.
 #include <benchmark/benchmark.h>
 
-#include "core/step.hpp"
+#include "engine/step.hpp"
 
 namespace voussoir {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/model.hpp"
-#include "core/step.hpp"
+#include "engine/step.hpp"
 #include "mesh/rectangle.hpp"
 
 namespace voussoir::bench {

@@ -291,7 +291,7 @@ struct ElementStageResult {
   double strain_energy = 0.0;  // sum of V0 W over free triangles [J]
   double damping_power = 0.0;  // sum of V0 J eta D:D at the current velocities [W]
   // sum of V0 P_v(previous step) : Fdot(current velocities) [W]: the power of the previous
-  // step's viscous forces at the current half-step velocity (energy ledger, core/step.cpp).
+  // step's viscous forces at the current half-step velocity (energy ledger, engine/step.cpp).
   double previous_damping_power = 0.0;
 };
 

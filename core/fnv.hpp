@@ -1,6 +1,6 @@
 #pragma once
-// FNV-1a, 64 bit: the one fingerprint hash of the project (checkpoints, io/checkpoint.cpp;
-// the journals of capacity and sweep, drivers/journal.hpp). Not cryptographic: it tells a
+// FNV-1a, 64 bit: the one fingerprint hash of the project (checkpoints, engine/checkpoint.cpp;
+// the journals of capacity and sweep, engine/journal.hpp). Not cryptographic: it tells a
 // file written for another model or settings from ours.
 
 #include <cstdint>
@@ -12,7 +12,7 @@
 namespace voussoir {
 
 // Values and arrays as bytes into Sink::bytes(p, n): the hash below and the checkpoint writer
-// (io/checkpoint.cpp) take the same byte stream. An array is its size (u64) then its items.
+// (engine/checkpoint.cpp) take the same byte stream. An array is its size (u64) then its items.
 template <class Sink>
 struct ByteWriter {
   template <class T>

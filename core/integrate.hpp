@@ -2,7 +2,7 @@
 // Central-difference (leapfrog) integration: the velocities stored in Nodes are half-step
 // velocities. Step n, with forces f^n evaluated at x^n (and the damping at v^(n-1/2)):
 //     v^(n+1/2) = v^(n-1/2) + dt f^n / m,      x^(n+1) = x^n + dt v^(n+1/2)
-// (velocity then position, SPEC section 1). Nodes of fixed blocks are never touched.
+// (velocity then position, docs/design.md, "The step"). Nodes of fixed blocks are never touched.
 //
 // Kinetic energy at step n (energy ledger). We book
 //     K^n = 1/2 sum_i m_i v_i^(n-1/2) . v_i^(n+1/2)

@@ -140,7 +140,7 @@ struct RigidBodies {
   std::vector<double> cx0, cy0;         // reference centroid [m]
   std::vector<double> mass, inertia;    // M [kg], polar moment about the centroid [kg m2]
   // the mass the body loads act on [kg]: M, also when the quasi-static phases scale `mass`
-  // and `inertia` (core/step.hpp equalize_rigid_inertia)
+  // and `inertia` (engine/step.hpp equalize_rigid_inertia)
   std::vector<double> load_mass;
   // per node: offset from the block's reference centroid [m]
   std::vector<double> rx, ry;

@@ -1,10 +1,10 @@
 #pragma once
-// Rigid blocks (SPEC section 1, `material.model = "rigid"`; docs/rigid.md).
+// Rigid blocks (`material.model = "rigid"`; docs/rigid.md).
 //
 // A rigid block is one body: centroid c, rotation theta, velocity v and angular velocity
 // omega. Its outline is what touches (contact/rigid_contact.hpp): the contact stage adds its
 // forces and moments to the body's force F and moment T about c, the body loads add M a at c
-// (core/step.hpp), and the same central-difference scheme as the nodes (core/integrate.hpp)
+// (engine/step.hpp), and the same central-difference scheme as the nodes (core/integrate.hpp)
 // advances the body (STYLE.md "Body kinds sit side by side": the kinds differ in how forces
 // become motion):
 //     v^(n+1/2) = v^(n-1/2) + dt F^n / M,        c^(n+1) = c^n + dt v^(n+1/2),

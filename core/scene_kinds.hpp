@@ -1,6 +1,6 @@
 #pragma once
-// The scene kinds of a deck's [model] (SPEC.md section 3): one registry that the deck reader
-// (io/deck.cpp: the allowed `model.kind` values and their required keys), the scene builder
+// The scene kinds of a deck's [model] (docs/reference/deck.md, [model]): one registry that the deck
+// reader (io/deck.cpp: the allowed `model.kind` values and their required keys), the scene builder
 // (mesh/scene.cpp: which generator builds the kind) and the drivers (is it an arch: its
 // reference length is the centreline radius) all read. Adding a kind is one row here plus its
 // generator in mesh/ (a new SceneBuilder value is a new case of mesh/scene.cpp's switch, which

@@ -1,6 +1,6 @@
 #pragma once
-// Supports that move ([supports], SPEC section 3): a fixed block's prescribed displacement and
-// rotation, reached quasi-statically after the settle under gravity.
+// Supports that move ([supports], docs/reference/deck.md): a fixed block's prescribed displacement
+// and rotation, reached quasi-statically after the settle under gravity.
 //
 // Motion. Block b moves by u(t) = s(tau) (dx, dy) and turns by theta(t) = s(tau) R about its
 // reference centroid c0, tau = (t - start) / ramp clamped to [0, 1], with the ramp
@@ -10,7 +10,7 @@
 // the support); its peak speed is 2 |d| / ramp. A point X of the block goes to
 //     x(t) = c0 + u(t) + R(theta(t)) (X - c0).
 //
-// Step. The supports are one more stage of core/step.hpp (stage 7, after the integration):
+// Step. The supports are one more stage of engine/step.hpp (stage 7, after the integration):
 // as for a free body, the state after step n is the pose at t^(n+1) and the half-step velocity
 //     v^(n+1/2) = (x(t^(n+1)) - x(t^n)) / dt,
 // so the next contact stage sees the support where it is and the joint friction and dashpots
@@ -21,7 +21,7 @@
 // Energy. The supports do work on the structure through the contact forces F on the support
 // (the sum of the pair forces on its outline; their moment T about its centroid for a rigid
 // block). Over the increment x^n - x^(n-1) = dt v^(n-1/2), by the trapezoid as every other
-// work in the ledger (core/step.cpp),
+// work in the ledger (engine/step.cpp),
 //     W_supports += -dt/2 [(F^n + F^(n-1)) . v^(n-1/2) + (T^n + T^(n-1)) omega^(n-1/2)],
 // booked as external work: the balance K + U + contact + dissipated = external work then holds
 // with the supports moving (the friction and dashpot work of the contact stage includes the

@@ -1,5 +1,5 @@
 #pragma once
-// Deck reading and validation (SPEC.md "Deck keys"). Every failure throws DeckError with one
+// Deck reading and validation (docs/reference/deck.md). Every failure throws DeckError with one
 // line naming the key, the value and what is allowed (or the file, line and column of a TOML
 // syntax error); the program turns it into exit status 2.
 

@@ -1,5 +1,5 @@
 #pragma once
-// HDF5 output of one run (SPEC.md section 5), plus an XDMF file beside it for ParaView.
+// HDF5 output of one run (docs/reference/output.md), plus an XDMF file beside it for ParaView.
 //
 // File layout (all floating-point data float64, integers int32 unless said):
 //   /                      attributes: complete (int32: 1 only once close_complete() ran),
@@ -47,7 +47,7 @@
 // ParaView 5.11's XDMF Reader and Xdmf3ReaderS/T (tests/python/paraview_open.py) and with
 // h5py (tests/python/xdmf_h5.py).
 //
-// Completeness contract (SPEC.md: "no partial file left looking complete"):
+// Completeness contract (docs/design.md, "Output": no partial file left looking complete):
 //   - open() removes any earlier `path` and its .xdmf, and writes to `path + ".tmp"` with
 //     complete = 0;
 //   - close_complete() closes the file, renames it to `path`, sets complete = 1 there and then
@@ -59,10 +59,10 @@
 //
 // Non-finite values are refused (std::runtime_error naming the field, the item and the time):
 // a NaN is never written silently. The one NaN the file holds on purpose is the open joint's
-// eccentricity and point (both NaN together, never infinite). Errors of the HDF5 library or the file system throw
-// OutputError (io/json.hpp) naming the file.
-// Series rows are buffered in memory and written in blocks (every kSeriesBlock rows, at each
-// snapshot and at close), so appending a row costs no HDF5 call in the common case.
+// eccentricity and point (both NaN together, never infinite). Errors of the HDF5 library or the
+// file system throw OutputError (io/json.hpp) naming the file. Series rows are buffered in memory
+// and written in blocks (every kSeriesBlock rows, at each snapshot and at close), so appending a
+// row costs no HDF5 call in the common case.
 
 #include <cstdint>
 #include <memory>
@@ -91,7 +91,7 @@ struct SeriesRecord {
   std::vector<double> control_displacements;
 };
 
-// Joint resultants of one snapshot, J values each (drivers/thrust.hpp makes them).
+// Joint resultants of one snapshot, J values each (engine/thrust.hpp makes them).
 struct SnapshotJoints {
   std::vector<double> normal_force;  // [N], compression positive
   std::vector<double> shear_force;   // [N]

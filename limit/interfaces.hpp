@@ -32,7 +32,7 @@ struct Interface {
   double position_deg = std::numeric_limits<double>::quiet_NaN();  // of the matching joint
   // Ends that carry no force: the LP fixes their cone edges at zero. Set for the open joints
   // of a structure whose supports moved, each kept as a point contact at its pivot
-  // (drivers/capacity.hpp moved_blocks, OpenJoints::Points); find_interfaces sets neither.
+  // (commands/capacity.hpp moved_blocks, OpenJoints::Points); find_interfaces sets neither.
   bool open_a = false, open_b = false;
   double length() const;
 };

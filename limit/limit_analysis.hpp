@@ -4,7 +4,7 @@
 // the collapse mechanism from the dual solution, and gravity-only admissibility. The
 // formulation is derived at the top of limit_analysis.cpp and in docs/limit.md.
 //
-// Uses: `voussoir limit` (drivers/command_limit.cpp); `voussoir capacity` seeds its bracket
+// Uses: `voussoir limit` (commands/limit.cpp); `voussoir capacity` seeds its bracket
 // with lambda_la; `voussoir stability` cross-checks cells with the gravity-only test;
 // `voussoir limit --thrust min|max` and `voussoir spread` compare the support thrust of a
 // moved structure with the least and greatest thrust (limit_thrust).
@@ -17,7 +17,7 @@
 
 namespace voussoir {
 
-// One joint of the collapse mechanism (fields as in the FDEM hinge report, drivers/kinematics).
+// One joint of the collapse mechanism (fields as in the FDEM hinge report, engine/kinematics.hpp).
 // LimitResult::mechanism is sorted by Model::joints index, interfaces without a joint last.
 struct MechanismJoint {
   Index interface = 0;  // index into LimitResult::interfaces
@@ -83,7 +83,7 @@ struct LimitOptions {
   // The interfaces to use instead of find_interfaces (null: found from the outlines). For
   // blocks whose outlines no longer meet face to face: a structure whose supports moved opens
   // its hinges, and its joints are then the reference ones carried with their blocks
-  // (drivers/capacity.hpp moved_blocks).
+  // (commands/capacity.hpp moved_blocks).
   const std::vector<Interface>* interfaces = nullptr;
 };
 

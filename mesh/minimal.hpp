@@ -1,5 +1,5 @@
 #pragma once
-// Minimal meshes for rigid blocks (SPEC section 7: no element work where the blocks'
+// Minimal meshes for rigid blocks (docs/rigid.md: no element work where the blocks'
 // deformation does not change the answer; mesh.chord_tolerance).
 //
 // A rigid block needs triangles only for its contact geometry: its outline. Each block's

@@ -1,6 +1,6 @@
 #pragma once
-// Scene generators (SPEC.md section 3): build the blocks of a deck's [model] and mesh each
-// into constant-strain triangles ([mesh] size or through_thickness). Geometry errors throw
+// Scene generators (docs/reference/deck.md, [model]): build the blocks of a deck's [model] and mesh
+// each into constant-strain triangles ([mesh] size or through_thickness). Geometry errors throw
 // DeckError naming the key and value. mesh/ reads only the deck's scene parameters
 // (SceneParams, core/schema.hpp: [model], [mesh], [material] and the deck's path), never the
 // whole Config; callers pass scene_params(config). The kinds and their generators:

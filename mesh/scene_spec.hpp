@@ -4,10 +4,10 @@
 // `mesh_scene(build_scene(params), params)`; tests use the two halves separately (exact
 // outline areas, centreline geometry).
 //
-// Conventions shared by every generator (SPEC.md section 3):
+// Conventions shared by every generator (docs/reference/deck.md, [model]):
 //   - a key the deck did not give (ModelConfig::given) takes the default of the scene kind
-//     where SPEC gives one that differs from core/schema.hpp's: the church's thickness is 0.5 m
-//     and a block's height 1.0 m;
+//     where the published geometry gives one that differs from core/schema.hpp's: the church's
+//     thickness is 0.5 m and a block's height 1.0 m;
 //   - lengths in m, angles in the deck in degrees, here in radians unless the name says deg;
 //   - a scene that is mirror-symmetric has its axis at x = 0; the blocks of its left half are
 //     built as exact mirror images (sign of x flipped) of those of its right half, and blocks

@@ -1,4 +1,4 @@
-// Arch scenes (SPEC.md section 3): circular_arch, basket_arch and buttressed_arch.
+// Arch scenes (docs/reference/deck.md, [model]): circular_arch, basket_arch and buttressed_arch.
 //
 // Geometry. Every arch here is symmetric about x = 0 and its centreline is a chain of circular
 // arcs. Only the right half is computed: pieces from the crown (u = 0) to the right springing
@@ -26,7 +26,8 @@
 //     centreline direction beyond the springing, normal to the joint), so its top face is
 //     exactly the springing joint and every corner is square (vertical sides would leave a
 //     90 - g degree corner at E, too sharp to mesh well for small embraces).
-//   buttressed_arch: a free buttress on each side (SPEC: inner face vertical through I, top
+//   buttressed_arch: a free buttress on each side (the published geometry: inner face vertical
+//   through I, top
 //     along the joint to E, then horizontal out to x_I + B, outer face down to the ground line
 //     y = -H1), monolithic or in horizontal courses of height `courses` from the ground up (the
 //     top course, which carries the springing, takes what is left, so it may be shorter or,

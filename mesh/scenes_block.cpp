@@ -1,5 +1,5 @@
-// The block scene (SPEC.md section 3): `stack` rectangular blocks `width` x `height` standing
-// on a fixed ground, optionally on an incline.
+// The block scene (docs/reference/deck.md, [model]): `stack` rectangular blocks `width` x `height`
+// standing on a fixed ground, optionally on an incline.
 //
 // Geometry, before the incline: the blocks are centred on x = 0, block k spans
 // y in [k height, (k + 1) height]; the ground is a fixed rectangle under them whose top is
@@ -44,8 +44,8 @@ Vec2 rotate(Vec2 p, double c, double s) {
 
 Scene build_block_scene(const SceneParams& params) {
   const ModelConfig& mc = params.model;
-  // SPEC gives no block height; core/schema.hpp's 5.0 is the church's. A block deck without
-  // `height` gets a 1.0 m block.
+  // The published cases give no block height; core/schema.hpp's 5.0 is the church's. A block deck
+  // without `height` gets a 1.0 m block.
   const double w = mc.width, ht = mc.has("height") ? mc.height : 1.0, incline = mc.incline;
   const int stack = mc.stack;
   if (!(w > 0.0)) geometry_error(params, "model.width", w, "expected a width > 0 m");

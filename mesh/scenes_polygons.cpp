@@ -1,5 +1,5 @@
-// The polygons scene (SPEC.md section 3): blocks read from a file, fixed ones listed by
-// `model.fixed` (0-based block indices).
+// The polygons scene (docs/reference/deck.md, [model]): blocks read from a file, fixed ones listed
+// by `model.fixed` (0-based block indices).
 //
 // Two file formats, told apart by content (a gmsh file starts with `$MeshFormat`):
 //
@@ -179,14 +179,21 @@ struct GmshBlocks {
   std::vector<std::string> names;  // physical name, "physical TAG" or "surface TAG"
 };
 
-GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
-  std::istringstream in(text);
-  std::string tok;
-  auto fail = [&](const std::string& why) { throw FileError{name + ": " + why}; };
+// The sections of an MSH 4.1 ASCII file that make blocks: the physical tags and names of the
+// surfaces, the nodes, the triangles of each surface.
+struct GmshSections {
   std::map<int, int> surface_physical;  // surface tag -> first physical tag (absent: none)
   std::map<int, std::string> physical_names;  // physical surface tag -> its name
   std::map<std::size_t, std::array<double, 3>> nodes;
   std::map<int, std::vector<std::array<std::size_t, 3>>> surface_tris;
+};
+
+GmshSections read_gmsh_sections(const std::string& text, const std::string& name) {
+  std::istringstream in(text);
+  std::string tok;
+  auto fail = [&](const std::string& why) { throw FileError{name + ": " + why}; };
+  GmshSections sections;
+  auto& [surface_physical, physical_names, nodes, surface_tris] = sections;
   bool format_ok = false;
   while (in >> tok) {
     if (tok == "$MeshFormat") {
@@ -289,6 +296,13 @@ GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
   }
   if (!format_ok) fail("no $MeshFormat section");
   if (surface_tris.empty()) fail("no triangles on any surface");
+  return sections;
+}
+
+GmshBlocks read_gmsh(const std::string& text, const std::string& name) {
+  auto fail = [&](const std::string& why) { throw FileError{name + ": " + why}; };
+  const GmshSections sections = read_gmsh_sections(text, name);
+  const auto& [surface_physical, physical_names, nodes, surface_tris] = sections;
 
   // Surfaces -> blocks.
   bool any_phys = false, all_phys = true;

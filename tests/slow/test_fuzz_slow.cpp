@@ -1,8 +1,8 @@
-// Bad input (SPEC section 2: exit status 2, never a crash), full set: 300 mutated versions of each
-// shipped deck and 200 of each geometry file (3100 inputs to `voussoir check`), every third one
-// also to `voussoir run` (1034 runs); about ten minutes on two cores. Seeds differ from the default
-// share (tests/unit/test_fuzz.cpp), so these are other inputs; contract and mutations in
-// tests/unit/fuzz_inputs.hpp.
+// Bad input (docs/reference/commands.md: exit status 2, never a crash), full set: 300 mutated
+// versions of each shipped deck and 200 of each geometry file (3100 inputs to `voussoir check`),
+// every third one also to `voussoir run` (1034 runs); about ten minutes on two cores. Seeds differ
+// from the default share (tests/unit/test_fuzz.cpp), so these are other inputs; contract and
+// mutations in tests/unit/fuzz_inputs.hpp.
 
 #include "../unit/fuzz_inputs.hpp"
 

@@ -14,9 +14,9 @@
 #include <cstdio>
 #include <string>
 
-#include "drivers/kinematics.hpp"
-#include "drivers/run.hpp"
-#include "drivers/setup.hpp"
+#include "engine/kinematics.hpp"
+#include "engine/run_loop.hpp"
+#include "engine/setup.hpp"
 #include "io/deck.hpp"
 
 namespace voussoir {

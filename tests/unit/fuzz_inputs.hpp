@@ -1,14 +1,14 @@
 #pragma once
-// Bad-input fuzzing of the voussoir program (SPEC section 2, exit statuses): deterministic
-// mutations of the shipped decks (cases/*.toml) and of the polygon and gmsh files of tests/data,
-// fed to `voussoir check` and `voussoir run` in a child process with a wall-clock, CPU and memory
-// limit (tests/unit/subprocess.hpp). Shared by tests/unit/test_fuzz.cpp (the default share) and
-// tests/slow/test_fuzz_slow.cpp (the full set).
+// Bad-input fuzzing of the voussoir program (docs/reference/commands.md, exit statuses):
+// deterministic mutations of the shipped decks (cases/*.toml) and of the polygon and gmsh files of
+// tests/data, fed to `voussoir check` and `voussoir run` in a child process with a wall-clock, CPU
+// and memory limit (tests/unit/subprocess.hpp). Shared by tests/unit/test_fuzz.cpp (the default
+// share) and tests/slow/test_fuzz_slow.cpp (the full set).
 //
-// Contract checked for every input (SPEC.md section 2, exit status):
+// Contract checked for every input (docs/reference/commands.md, exit status):
 //   check: exit 0, or exit 2 with a "voussoir: error:" message;
 //   run:   the same, or exit 1 with a "voussoir: run failed:" message naming the step (a run
-//          that a guard stopped: drivers/run.hpp; the deck was valid but its numbers were not
+//          that a guard stopped: engine/run_loop.hpp; the deck was valid but its numbers were not
 //          runnable, e.g. lambda = 1e300);
 //   never a signal (crash, abort, sanitizer report), never the time limit (hang), never the
 //   memory limit (std::bad_alloc would surface as exit 1 without a step: refused as well).

@@ -42,13 +42,13 @@
 #include <string>
 #include <vector>
 
+#include "commands/pulse.hpp"
 #include "core/rigid.hpp"
-#include "core/step.hpp"
-#include "drivers/pulse.hpp"
-#include "drivers/setup.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
 #include "housner.hpp"
-#include "io/accelerogram.hpp"
 #include "io/deck.hpp"
+#include "seismic/accelerogram.hpp"
 
 namespace voussoir::testing {
 

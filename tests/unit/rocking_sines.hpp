@@ -11,7 +11,7 @@
 // (2.7 g), so the block rocks and never slides, as Housner's block on its rigid base.
 //
 // Signal: `[load.base] signal = "windowed_sine"`, three cycles (the deck default) at 1, 1.5, 2
-// and 3 Hz, a_g = A w(2t/T - 1) sin(2 pi f t) (core/base_motion.hpp), whose peak is 0.891 A.
+// and 3 Hz, a_g = A w(2t/T - 1) sin(2 pi f t) (seismic/base_motion.hpp), whose peak is 0.891 A.
 // The reference reads the same function sampled 200 times a cycle, linear between samples (at
 // 400 a cycle and four times the steps no robust outcome changes: the test checks it). An
 // amplitude is named by its peak (PGA) S, as a record's scale is, and voussoir is given
@@ -36,8 +36,8 @@
 #include <string>
 #include <vector>
 
-#include "core/base_motion.hpp"
 #include "rocking_records.hpp"
+#include "seismic/base_motion.hpp"
 
 namespace voussoir::testing {
 

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <string>
 
-#include "drivers/capacity.hpp"
+#include "commands/capacity.hpp"
 
 namespace voussoir {
 

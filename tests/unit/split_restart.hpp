@@ -8,8 +8,8 @@
 #include <utility>
 
 #include "core/rigid.hpp"
-#include "core/step.hpp"
-#include "io/checkpoint.hpp"
+#include "engine/checkpoint.hpp"
+#include "engine/step.hpp"
 
 namespace voussoir::testing {
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "io/accelerogram.hpp"
 #include "io/deck.hpp"
+#include "seismic/accelerogram.hpp"
 
 namespace voussoir {
 namespace {

@@ -1,4 +1,4 @@
-// The bracketing search of capacity and the pulse curve (drivers/bracket.hpp).
+// The bracketing search of capacity and the pulse curve (engine/bracket.hpp).
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <map>
 #include <vector>
 
-#include "drivers/bracket.hpp"
+#include "engine/bracket.hpp"
 
 namespace voussoir {
 namespace {

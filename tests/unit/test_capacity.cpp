@@ -1,4 +1,4 @@
-// Capacity by bisection against the analytic rigid-block values (SPEC.md section 3, `block`):
+// Capacity by bisection against the analytic rigid-block values (cases/README.md, `block`):
 // a block of width/height 0.5 overturns at lambda* = 0.5 when mu > 0.5 and slides at
 // lambda* = mu otherwise.
 
@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "drivers/capacity.hpp"
-#include "drivers/setup.hpp"
+#include "commands/capacity.hpp"
+#include "engine/setup.hpp"
 #include "io/deck.hpp"
 #include "same_search.hpp"
 

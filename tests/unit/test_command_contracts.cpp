@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/pushover.hpp"
+#include "commands/pushover.hpp"
 #include "subprocess.hpp"
 
 namespace voussoir {

@@ -14,8 +14,8 @@
 #include <numbers>
 
 #include "contact/contact.hpp"
-#include "core/step.hpp"
-#include "drivers/setup.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
 #include "io/deck.hpp"
 #include "mesh/rectangle.hpp"
 

@@ -1,4 +1,4 @@
-// drivers/dealer.hpp in one process (no mpirun): every cell not finished runs once, on the
+// engine/dealer.hpp in one process (no mpirun): every cell not finished runs once, on the
 // threads, with its input; every record is taken once; a failing take is rethrown after the
 // other cells ran. The MPI path is tested through the program (ctest -L mpi,
 // tests/python/mpi_ranks.py).
@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "drivers/dealer.hpp"
+#include "engine/dealer.hpp"
 
 namespace voussoir {
 namespace {

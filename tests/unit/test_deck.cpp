@@ -22,7 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Every key of SPEC "Deck keys", each with a value different from its default.
+// Every key of docs/reference/deck.md, each with a value different from its default.
 const char* kFullDeck = R"(
 [model]
 kind = "buttressed_arch"

@@ -1,4 +1,4 @@
-// Dynamics of the explicit step (core/step.cpp) with contact off: elastic bar period and
+// Dynamics of the explicit step (engine/step.cpp) with contact off: elastic bar period and
 // energy conservation, the stable time step (bounded below it, blow-up above it), Munjiza
 // damping leaving rigid motion alone, the energy ledger of a damped falling block, exact free
 // fall, fixed blocks.
@@ -14,7 +14,7 @@
 
 #include "core/cst.hpp"
 #include "core/model.hpp"
-#include "core/step.hpp"
+#include "engine/step.hpp"
 #include "mesh/rectangle.hpp"
 
 namespace voussoir {

@@ -1,4 +1,4 @@
-// The engine (drivers/trial.hpp): its guards in every classified run, its load program, and
+// The engine (engine/trial.hpp): its guards in every classified run, its load program, and
 // its limits on the command line. The guard tests run the program end to end: a deck value
 // the reader accepts whose run overflows, in a capacity trial, a pulse run and a stability
 // cell; each must exit with status 1 and a message naming the run, the time and the quantity.
@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "drivers/plot.hpp"
-#include "drivers/setup.hpp"
-#include "drivers/trial.hpp"
+#include "engine/setup.hpp"
+#include "engine/trial.hpp"
 #include "io/deck.hpp"
+#include "io/plot.hpp"
 #include "subprocess.hpp"
 
 namespace voussoir {
@@ -119,7 +119,7 @@ TEST(LoadProgram, RampsAndSignalFromTheSimulationTime) {
 }
 
 TEST(Plot, AFailedScriptIsAWarningNotAnError) {
-  // drivers/plot.hpp: a script that fails (here: one that does not exist) returns false and
+  // io/plot.hpp: a script that fails (here: one that does not exist) returns false and
   // says so on stderr; nothing is thrown, so the command's exit status stays that of its result.
   EXPECT_FALSE(draw_with_script("no_such_script", {"a.csv", "-o", "a.png"}, "a.png"));
 }

@@ -1,8 +1,9 @@
-// Bad input (SPEC section 2: exit status 2, never a crash), default share: 100 mutated versions of
-// each of the nine shipped decks and 60 of each geometry file (polygon text, gmsh) -- 1020 inputs
-// to `voussoir check`, every tenth also to `voussoir run` with a 1e-4 s end time (102 runs). The
-// contract and the mutations are in tests/unit/fuzz_inputs.hpp; the full set (5x more, every third
-// input run) is tests/slow/test_fuzz_slow.cpp. Seeds are fixed: the same inputs on every run.
+// Bad input (docs/reference/commands.md: exit status 2, never a crash), default share: 100 mutated
+// versions of each of the nine shipped decks and 60 of each geometry file (polygon text, gmsh) --
+// 1020 inputs to `voussoir check`, every tenth also to `voussoir run` with a 1e-4 s end time (102
+// runs). The contract and the mutations are in tests/unit/fuzz_inputs.hpp; the full set (5x more,
+// every third input run) is tests/slow/test_fuzz_slow.cpp. Seeds are fixed: the same inputs on
+// every run.
 
 #include "fuzz_inputs.hpp"
 
@@ -63,7 +64,7 @@ TEST(Fuzz, GmshFile) {
 }  // namespace
 }  // namespace voussoir::testing
 
-// Inputs the fuzzer found that broke the exit-status contract (SPEC section 2),
+// Inputs the fuzzer found that broke the exit-status contract (docs/reference/commands.md),
 // each reduced to --set overrides of a shipped deck (or a two-line polygon change), kept here so
 // that a fix is seen at once and never undone. Each must exit 0 or 2 from `check`; the last
 // one must finish a 1e-4 s `run` within the fuzz time limit (or be refused).
@@ -172,7 +173,7 @@ TEST(FuzzFindings, ChurchTinyHeight) {
   EXPECT_TRUE(ok.exited && ok.status == 0) << ok.describe() << "\n" << ok.err;
 }
 
-// drivers/setup.cpp: a damping factor of 9e18 made a stable step of 1.9e-25 s, refused only by
+// engine/setup.cpp: a damping factor of 9e18 made a stable step of 1.9e-25 s, refused only by
 // the run loop (exit 1) after set-up (slow fuzz tier). Now refused up front.
 TEST(FuzzFindings, AbsurdDampingTimeStep) {
   expect_refused_naming(

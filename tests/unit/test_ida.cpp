@@ -1,5 +1,5 @@
-// Incremental dynamic analysis (`voussoir ida`, drivers/ida.hpp) and its lognormal fragility
-// fit (core/fragility.hpp): the maximum-likelihood fit against a hand case and against samples
+// Incremental dynamic analysis (`voussoir ida`, commands/ida.hpp) and its lognormal fragility
+// fit (seismic/fragility.hpp): the maximum-likelihood fit against a hand case and against samples
 // drawn from a known lognormal, with and without censoring; the bootstrap interval; an IDA of
 // a slender rigid block under three records, its intensity measures, threads, resume and bad
 // input; a record the block outlasts, censored, in the fit of a real run. The figures printed here
@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "core/fragility.hpp"
-#include "core/spectrum.hpp"
+#include "seismic/fragility.hpp"
+#include "seismic/spectrum.hpp"
 #include "slender_block.hpp"
 #include "subprocess.hpp"
 
@@ -185,7 +185,7 @@ TEST(Fragility, LogSurvivalFarInTheUpperTail) {
   EXPECT_NEAR(log_normal_survival(-40.0), 0.0, 1e-300);
 }
 
-// A record that collapses at every intensity tried, down to the smallest x (drivers/pulse.hpp
+// A record that collapses at every intensity tried, down to the smallest x (commands/pulse.hpp
 // kMinAmplitude), enters the fit censored below: ln Phi(z). The fit is the maximum of that
 // likelihood: no point of a fine grid around it does better, and the record pulls the median
 // down.
@@ -446,7 +446,7 @@ std::string write_burst() {
   return path;
 }
 
-// ln L(mu, beta) of the lognormal fit (core/fragility.hpp's header), written out again: a
+// ln L(mu, beta) of the lognormal fit (seismic/fragility.hpp's header), written out again: a
 // collapsed record -ln beta - z^2 / 2, one censored above ln(1 - Phi(z)), one censored below
 // ln Phi(z), z = (ln x - mu) / beta.
 double log_likelihood(const std::vector<IntensitySample>& samples, double mu, double beta) {
@@ -486,7 +486,7 @@ double golden_max(F f, double lo, double hi) {
 // to the search's cap (censored at the largest intensity it survived). The JSON's fragility is
 // the maximum-likelihood lognormal of the records as the same JSON gives them, found here by
 // golden-section searches (ln L is concave in mu at fixed beta; the profile over ln beta is
-// searched the same way), independently of core/fragility.cpp's Brent searches; and it is not
+// searched the same way), independently of seismic/fragility.cpp's Brent searches; and it is not
 // the fit that would take the censored record for a collapse.
 TEST(Ida, CensoredRecordEntersTheFragilityFit) {
   const std::vector<std::string> records = {write_record(0), write_record(1), write_record(2),

@@ -1,6 +1,6 @@
 // Rigid-block limit analysis (limit/): interfaces found from block outlines, the LP against
 // analytic answers (single block, stack, incline) and published arch values (Dimitri and
-// Tornabene 2015, SPEC.md section 6), gravity-only admissibility against the minimum
+// Tornabene 2015, docs/regression.md), gravity-only admissibility against the minimum
 // thickness of a semicircular arch (Heyman / Milankovitch: t/R ~ 0.1075 for a continuous
 // arch), and two-ways checks: the primal forces satisfy every block's equilibrium and the
 // friction cones, and the dual mechanism's virtual work gives back the same lambda.
@@ -193,7 +193,7 @@ TEST(LimitBlock, OverturnsAtWidthOverHeightOrSlidesAtMu) {
 }
 
 // An interface end marked open carries no force (the open joints of a moved structure as point
-// contacts, drivers/capacity.hpp OpenJoints::Points). The block (b/h = 0.5, mu = 0.8) on its
+// contacts, commands/capacity.hpp OpenJoints::Points). The block (b/h = 0.5, mu = 0.8) on its
 // right toe alone stands only where the load's moment about the toe balances the weight's:
 // lambda = +b/h, the one admissible value; on its left toe alone, lambda = -b/h. Neither stands
 // under gravity alone.

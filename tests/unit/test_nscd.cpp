@@ -1,4 +1,4 @@
-// Rigid blocks by non-smooth contact dynamics (contact/nscd.hpp, core/step.cpp advance_nscd;
+// Rigid blocks by non-smooth contact dynamics (contact/nscd.hpp, engine/step.cpp advance_nscd;
 // docs/nscd.md): the local law solved exactly, the contact points of two pieces, a block at
 // rest stays still, free fall, the incline's stick and slip, Housner's loss at a rocking
 // impact, the energy ledger, a long chain of voussoirs settled by the cone solve, restart bit
@@ -18,8 +18,8 @@
 
 #include "contact/nscd.hpp"
 #include "core/rigid.hpp"
-#include "drivers/setup.hpp"
-#include "io/checkpoint.hpp"
+#include "engine/checkpoint.hpp"
+#include "engine/setup.hpp"
 #include "io/deck.hpp"
 #include "split_restart.hpp"
 #include "subprocess.hpp"

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/capacity.hpp"
+#include "commands/capacity.hpp"
 #include "io/deck.hpp"
 #include "same_search.hpp"
 #include "subprocess.hpp"

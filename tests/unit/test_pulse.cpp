@@ -1,4 +1,4 @@
-// Base-excitation runs (drivers/pulse): a rigid block under a constant base acceleration (a
+// Base-excitation runs (commands/pulse.hpp): a rigid block under a constant base acceleration (a
 // step from a file accelerogram) rocks over exactly when the acceleration exceeds
 // g width / height, the control points of the shaking-table arch, and the `pulse` command's
 // JSON.
@@ -12,10 +12,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "drivers/pulse.hpp"
-#include "io/accelerogram.hpp"
+#include "commands/pulse.hpp"
 #include "io/deck.hpp"
 #include "mesh/scene.hpp"
+#include "seismic/accelerogram.hpp"
 
 namespace voussoir {
 namespace {
@@ -112,7 +112,7 @@ TEST(PulseControlPoints, ScaledArchSixthVoussoirExtrados) {
   EXPECT_EQ(model.blocks[points[0].block].role, "voussoir");
 }
 
-// `voussoir pulse --json` writes the keys of SPEC section 2 and exits 0; a deck without a
+// `voussoir pulse --json` writes the keys of docs/reference/output.md and exits 0; a deck without a
 // signal is refused with exit status 2.
 TEST(PulseCommand, JsonSummary) {
   const std::string record = write_step(0.3, 0.2);

@@ -1,6 +1,6 @@
 // `voussoir pulse --curve` on the rigid block of cases/block.toml (width/height = 0.5,
 // mu = 0.8): the collapse amplitude of a 3-cycle Bohman-windowed sine at 2 and 4 Hz, two
-// frequencies run in parallel. Checks: the JSON and CSV of SPEC section 2; the bisection
+// frequencies run in parallel. Checks: the JSON and CSV of docs/reference/output.md; the bisection
 // bracket (survived at lo, collapsed at hi, hi - lo within the tolerance); and physics: the
 // block cannot start rocking unless the pulse peak (0.891 A for 3 cycles) exceeds
 // g width/height, so A_c >= 0.5 / 0.891 = 0.561 g, and a faster pulse needs more amplitude
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/pulse.hpp"
+#include "commands/pulse.hpp"
 #include "io/deck.hpp"
 
 namespace {

@@ -1,4 +1,4 @@
-// The stepping amplitude search of `voussoir pulse --curve` (drivers/pulse.hpp) on a case whose
+// The stepping amplitude search of `voussoir pulse --curve` (commands/pulse.hpp) on a case whose
 // collapse is not monotone in the amplitude: a slender rigid block (width 0.2 m, height 1 m,
 // b/h = 0.2, mu = 0.8 so it rocks and never slides) under one full sine cycle of base
 // acceleration (`sine_pulse`) at 5 Hz.

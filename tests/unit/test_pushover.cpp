@@ -1,4 +1,4 @@
-// Capacity curves (drivers/pushover.hpp): a rigid block on a Winkler joint against the closed
+// Capacity curves (commands/pushover.hpp): a rigid block on a Winkler joint against the closed
 // form of its contact strip, and on a stiff joint against the rigid block's rocking curve; the
 // equivalent SDOF curve of a single block and of a hand-made two-block mechanism; the default
 // control block; bad options refused with the option and value.
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "drivers/pushover.hpp"
-#include "drivers/setup.hpp"
+#include "commands/pushover.hpp"
+#include "engine/setup.hpp"
 #include "io/deck.hpp"
 #include "limit/limit_analysis.hpp"
 #include "subprocess.hpp"

@@ -18,11 +18,11 @@
 #include <string>
 #include <vector>
 
+#include "commands/capacity.hpp"
 #include "core/rigid.hpp"
-#include "core/step.hpp"
-#include "drivers/capacity.hpp"
-#include "drivers/setup.hpp"
-#include "drivers/trial.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
+#include "engine/trial.hpp"
 #include "io/deck.hpp"
 #include "limit/limit_analysis.hpp"
 #include "subprocess.hpp"
@@ -140,7 +140,7 @@ TEST(LocalDamping, DisturbedBlockComesToRestAndTheLedgerCloses) {
   }
 }
 
-// The capacity trials' rest rule (drivers/trial.hpp RestRule with refuse_creep) on a stack of
+// The capacity trials' rest rule (engine/trial.hpp RestRule with refuse_creep) on a stack of
 // two rigid blocks moved by hand, sampled every millisecond at a tenth of the rest speed with
 // a kinetic energy that grows at every sample: the decay check alone never calls that rest.
 // Going back (every block's displacement since the start shrinks) is rest after one hold
@@ -329,7 +329,7 @@ TEST(KineticDamping, AStructureOutOfBalanceIsNotHeldStill) {
   EXPECT_LT(double(resets), 0.05 * double(steps)) << resets << " resets in " << steps << " steps";
 }
 
-// The rest rule's creep check (drivers/motion.hpp CreepDetector): a steady creep slow enough
+// The rest rule's creep check (engine/motion.hpp CreepDetector): a steady creep slow enough
 // for the speed criterion (the rigid sliding arch held back by the local damping,
 // docs/capacity.md) is refused however long it lasts; a decaying approach to a displaced
 // equilibrium, with the same early growth, is accepted once it has settled.
@@ -369,7 +369,7 @@ TEST(CreepCheck, SteadyCreepIsRefusedAndADecayingMotionAccepted) {
   EXPECT_FALSE(fresh.creeping());
 }
 
-// The analytic capacities of the block (SPEC.md section 3: overturning at b / h, sliding at
+// The analytic capacities of the block (cases/README.md, `block`: overturning at b / h, sliding at
 // mu) with quasi-static trials, rigid and elastic blocks.
 TEST(QuasiStaticCapacity, BlockKeepsItsAnalyticCapacities) {
   TrialCriteria crit;
@@ -471,14 +471,14 @@ TEST(Direction, BothReportsEachDirectionAndTheSmaller) {
   fs::remove_all(dir);
 }
 
-// Mass scaling of the quasi-static phases (core/step.hpp equalize_rigid_inertia) on the stack
+// Mass scaling of the quasi-static phases (engine/step.hpp equalize_rigid_inertia) on the stack
 // of three unequal blocks: each block's own stable step reaches the model's, which does not
 // change; the loads keep the true masses; impact damping and elastic blocks are left alone;
 // and lambda* is the same bracket as with the true inertia, towards both directions.
 TEST(MassScaling, EveryBlockReachesTheStepAndTheCapacityStays) {
   const fs::path dir = fs::temp_directory_path() / "voussoir_mass_scaling";
   fs::create_directories(dir);
-  // Undamped joints, as the quasi-static phases take them (drivers/capacity.cpp settle).
+  // Undamped joints, as the quasi-static phases take them (commands/capacity.cpp settle).
   const Config deck = polygon_deck(dir, 1.0, {"contact.restitution=1"});
   Simulation sim = make_simulation(deck);
   const std::vector<double> before = rigid_body_stable_steps(sim);

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "core/base_motion.hpp"
-#include "core/spectrum.hpp"
-#include "io/accelerogram.hpp"
+#include "seismic/accelerogram.hpp"
+#include "seismic/base_motion.hpp"
+#include "seismic/spectrum.hpp"
 #include "subprocess.hpp"
 
 namespace voussoir {
@@ -126,7 +126,7 @@ TEST(RecordsAt2, MalformedFilesNameFileAndLine) {
 }
 
 // Exact double integration of a uniform piecewise-linear record from rest (the table motion of
-// core/base_motion.hpp): the final table velocity and displacement.
+// seismic/base_motion.hpp): the final table velocity and displacement.
 void final_motion(const Accelerogram& rec, double& v, double& d) {
   v = d = 0.0;
   for (std::size_t k = 0; k + 1 < rec.time.size(); ++k) {
@@ -136,7 +136,7 @@ void final_motion(const Accelerogram& rec, double& v, double& d) {
   }
 }
 
-// A 3-cycle windowed sine at 1 Hz (0.3 g; it ends at rest and at d = 0, core/base_motion.hpp)
+// A 3-cycle windowed sine at 1 Hz (0.3 g; it ends at rest and at d = 0, seismic/base_motion.hpp)
 // in a 20 s record at dt = 0.01 s, plus a drift `offset + slope t` [m/s2, m/s3].
 Accelerogram drifting_record(double offset, double slope) {
   Accelerogram rec;

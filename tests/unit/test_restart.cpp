@@ -1,11 +1,11 @@
-// Checkpoint and restart of `voussoir run` (docs/robustness.md; io/checkpoint.hpp): a run
+// Checkpoint and restart of `voussoir run` (docs/robustness.md; engine/checkpoint.hpp): a run
 // restarted from a checkpoint ends bit for bit where the uninterrupted run ends -- every node
 // position and velocity, every ledger term, the step and the time -- and writes the same series
 // and summary. Scene: the shipped circular arch on a coarse mesh under lambda = 0.5 (above its
 // lambda* of 0.29), so blocks move and contacts open and close, with a 0.1 mm contact buffer so
 // that the broad phase re-detects several times after the restart point.
 //
-// Contact state (io/checkpoint.hpp "Contact state"): ContactSystem::save_state/restore_state
+// Contact state (engine/checkpoint.hpp "Contact state"): ContactSystem::save_state/restore_state
 // carry the candidate pairs, the friction slip history and the last detection's positions, so
 // runs with and without friction restart bit for bit.
 
@@ -21,10 +21,11 @@
 #include <string>
 #include <vector>
 
-#include "drivers/commands.hpp"
-#include "drivers/run.hpp"
-#include "drivers/setup.hpp"
-#include "io/checkpoint.hpp"
+#include "commands/common.hpp"
+#include "commands/run.hpp"
+#include "engine/checkpoint.hpp"
+#include "engine/run_loop.hpp"
+#include "engine/setup.hpp"
 #include "io/deck.hpp"
 #include "subprocess.hpp"
 

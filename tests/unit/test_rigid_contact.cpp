@@ -13,14 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "commands/capacity.hpp"
 #include "contact/quad_overlap.hpp"
 #include "contact/rigid_contact.hpp"
 #include "core/rigid.hpp"
-#include "core/step.hpp"
-#include "drivers/capacity.hpp"
-#include "drivers/run.hpp"
-#include "drivers/setup.hpp"
-#include "drivers/thrust.hpp"
+#include "engine/run_loop.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
+#include "engine/thrust.hpp"
 #include "io/deck.hpp"
 
 namespace voussoir {

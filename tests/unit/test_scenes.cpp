@@ -1,4 +1,4 @@
-// Scene tests (SPEC.md section 3): arch areas against the analytic
+// Scene tests (docs/reference/deck.md, [model]): arch areas against the analytic
 // centreline length x thickness, the basket crown height, mirror symmetry of every symmetric
 // scene, buttress and church dimensions and block counts, coincident joint faces without
 // overlap, polygon-file and gmsh imports against the built-in block, geometry validation
@@ -38,7 +38,7 @@ std::string arch_deck(const std::string& kind, double embrace, int through = 2) 
          std::to_string(through) + "\n";
 }
 
-// Analytic centreline length of SPEC's arches (independent of the generator's code path).
+// Analytic centreline length of the shipped arches (independent of the generator's code path).
 double analytic_length(const std::string& shape, double rc, double d, double r, double beta_deg) {
   const double beta = beta_deg * kDeg;
   if (shape == "circular") return rc * beta;
@@ -295,8 +295,8 @@ TEST(Scenes, ButtressDimensions) {
     const double g = 0.5 * (180.0 - beta) * kDeg;
     const double xi = 0.9 * std::cos(g), yi = 0.9 * std::sin(g);  // intrados springing
     const double xe = 1.1 * std::cos(g), ye = 1.1 * std::sin(g);  // extrados springing
-    // SPEC: inner face x = xi, ground y = -H1, outer face x = xi + B, top along the joint to
-    // (xe, ye) then horizontal.
+    // The published geometry: inner face x = xi, ground y = -H1, outer face x = xi + B, top along
+    // the joint to (xe, ye) then horizontal.
     const std::vector<Vec2> expected = {
         {xi, -3.0}, {xi + 0.8, -3.0}, {xi + 0.8, ye}, {xe, ye}, {xi, yi}};
     const Block& r = m.blocks[12];

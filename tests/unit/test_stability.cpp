@@ -1,4 +1,4 @@
-// Stiff and extreme cases (SPEC.md section 7 "Numerical stability"; docs/robustness.md): very stiff
+// Stiff and extreme cases (docs/robustness.md, "Stiff and extreme cases"): very stiff
 // and very soft blocks, a large contact penalty, sliver triangles, no friction and very high
 // friction, very thin and very thick arches, a large lambda, very light and very heavy blocks.
 // Each case runs from rest with the automatic time step and asserts:
@@ -9,7 +9,7 @@
 //   - the automatic dt is the safety fraction of the stable limit, and stable in fact (the
 //     run stays finite and balanced for its whole length);
 //   - the expected outcome: stands, collapses, slides or sticks (thresholds below).
-// Then the guards of drivers/run.hpp: a user dt above the stable limit refused (exit 2, the
+// Then the guards of engine/run_loop.hpp: a user dt above the stable limit refused (exit 2, the
 // limit named), an unstable step stopped by the energy-drift guard or by the non-finite guard
 // with exit 1, the step, block and triangle named and the output file left incomplete.
 //
@@ -30,12 +30,13 @@
 #include <string>
 #include <vector>
 
+#include "commands/common.hpp"
+#include "commands/run.hpp"
 #include "core/model.hpp"
-#include "core/step.hpp"
-#include "drivers/commands.hpp"
-#include "drivers/kinematics.hpp"
-#include "drivers/run.hpp"
-#include "drivers/setup.hpp"
+#include "engine/kinematics.hpp"
+#include "engine/run_loop.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
 #include "io/deck.hpp"
 #include "mesh/scene.hpp"
 #include "subprocess.hpp"
@@ -48,8 +49,8 @@ namespace fs = std::filesystem;
 constexpr double kEnergyTolerance = 0.01;  // balance error below 1% of peak energy
 constexpr double kG = 9.81;
 
-// Outcome thresholds, on the rigid-body reading of the blocks (drivers/kinematics.hpp) with
-// L_ref = sqrt(smallest free block area), as capacity trials use them (drivers/capacity.hpp):
+// Outcome thresholds, on the rigid-body reading of the blocks (engine/kinematics.hpp) with
+// L_ref = sqrt(smallest free block area), as capacity trials use them (commands/capacity.hpp):
 //   collapsed: some block centroid moved more than 0.05 L_ref or turned more than 0.05 rad
 //              (the capacity collapse thresholds);
 //   stands:    every block centroid moved less than 0.005 L_ref and turned less than
@@ -244,7 +245,7 @@ TEST(Stability, ThinArchCollapsesUnderGravity) {
 }
 
 TEST(Stability, LambdaThreeCollapses) {
-  // lambda = 3, ten times lambda* = 0.29 of this arch (SPEC.md section 6): it is thrown over.
+  // lambda = 3, ten times lambda* = 0.29 of this arch (docs/regression.md): it is thrown over.
   const Config config = arch_deck({"load.lambda=3"});
   Built b = build(config);
   const Figures f = run_case("lambda = 3", b.sim, b.info.dt_stable, 0.05);
@@ -257,7 +258,7 @@ TEST(Stability, LambdaThreeCollapses) {
   }
 }
 
-// --- friction extremes on a single block (analytic outcomes, SPEC.md section 3 `block`) --------
+// --- friction extremes on a single block (analytic outcomes, cases/README.md, `block`) --------
 
 TEST(Stability, NoFrictionBlockSlidesAtLambdaG) {
   // mu = 0, lambda = 0.2 < width/height = 0.5 (no overturning): the block slides with

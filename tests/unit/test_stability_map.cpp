@@ -1,4 +1,4 @@
-// Gravity-only stability maps (drivers/stability.hpp, `voussoir stability`).
+// Gravity-only stability maps (commands/stability.hpp, `voussoir stability`).
 //
 // Scene: the shipped semicircular arch (cases/circular_arch.toml: Rc = 1 m, 11 voussoirs) on a
 // coarse mesh (one element through the thickness) with soft blocks (E = 40 MPa, so a 1 m arch
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/stability.hpp"
+#include "commands/stability.hpp"
 #include "io/deck.hpp"
 
 namespace voussoir {

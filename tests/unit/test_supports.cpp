@@ -5,7 +5,7 @@
 // supports spread apart carries the least thrust of limit analysis, pushed together the
 // greatest; spread by 1% of its span, its lambda* lies between the limit analyses with the
 // open joints as points and closed, and at the peak of its pushover), and the spreading study
-// (drivers/spread.hpp) and its command.
+// (commands/spread.hpp) and its command.
 
 #include <gtest/gtest.h>
 
@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "commands/capacity.hpp"
+#include "commands/spread.hpp"
 #include "core/rigid.hpp"
 #include "core/supports.hpp"
-#include "drivers/capacity.hpp"
-#include "drivers/setup.hpp"
-#include "drivers/spread.hpp"
-#include "drivers/thrust.hpp"
+#include "engine/setup.hpp"
+#include "engine/thrust.hpp"
 #include "io/deck.hpp"
 #include "limit/limit_analysis.hpp"
 #include "mesh/scene.hpp"
@@ -224,7 +224,7 @@ TEST(SupportsAcceptance, SpreadArchLambdaStarLiesBetweenTheTwoLimitAnalysesAndAt
       << refused.err;
 }
 
-// The spreading study (drivers/spread.hpp) on the same arch, its left support moved out in
+// The spreading study (commands/spread.hpp) on the same arch, its left support moved out in
 // two steps of 5.5 mm (0.25% of the width): at rest each time, on three hinges, its thrust
 // within 3% of the least thrust and growing with the spread (the arch flattens); the CSV and
 // the JSON carry every state.

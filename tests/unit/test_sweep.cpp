@@ -70,7 +70,7 @@ TEST(Sweep, ResumedSweepWritesTheSameCsv) {
   EXPECT_EQ(j.find("\"0.2\""), std::string::npos) << j;
   EXPECT_NE(j.find("\"failure_mode\": \"sliding\""), std::string::npos) << j;
 
-  // Keep the header (drivers/journal.hpp), the first finished cell and half a line of the
+  // Keep the header (engine/journal.hpp), the first finished cell and half a line of the
   // second: what a kill leaves.
   std::vector<std::string> lines;
   {

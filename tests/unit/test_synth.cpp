@@ -1,4 +1,4 @@
-// Artificial accelerograms (`voussoir synth`, core/synth.hpp): the EN 1998-1 Type 1 spectrum
+// Artificial accelerograms (`voussoir synth`, seismic/synth.hpp): the EN 1998-1 Type 1 spectrum
 // against hand values, a set of 7 records against the EC8 rules for a suite, reproducibility by
 // the seed, the AT2 writer against the reader, and the command's refusals. The figures printed
 // here are quoted in docs/records.md "Artificial records":
@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "core/spectrum.hpp"
-#include "core/synth.hpp"
-#include "io/accelerogram.hpp"
+#include "seismic/accelerogram.hpp"
+#include "seismic/spectrum.hpp"
+#include "seismic/synth.hpp"
 #include "subprocess.hpp"
 
 namespace voussoir {

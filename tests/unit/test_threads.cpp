@@ -20,8 +20,8 @@
 #include "contact/contact.hpp"
 #include "core/cst.hpp"
 #include "core/integrate.hpp"
-#include "core/step.hpp"
-#include "drivers/setup.hpp"
+#include "engine/setup.hpp"
+#include "engine/step.hpp"
 #include "io/deck.hpp"
 
 using namespace voussoir;

@@ -1,4 +1,4 @@
-// Joint resultants (drivers/thrust.hpp; the statics checks of docs/thrust.md): a block on a ground
+// Joint resultants (engine/thrust.hpp; the statics checks of docs/thrust.md): a block on a ground
 // carries its weight through the joint's middle; under lambda g the centre of pressure moves by
 // lambda (h/2) W / N towards the toe; the semicircular arch under gravity keeps every centre of
 // pressure inside its joints and its springings carry its weight; at the collapsed trial of its
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "drivers/capacity.hpp"
-#include "drivers/thrust.hpp"
+#include "commands/capacity.hpp"
+#include "engine/thrust.hpp"
 #include "io/deck.hpp"
 #include "subprocess.hpp"
 
@@ -169,8 +169,9 @@ TEST(Thrust, HingeJointsOfTheCollapsedTrialHaveTheirThrustAtAnEdge) {
   EXPECT_GE(hinges, 3);
 }
 
-// Through the program: `run --json` ends with the joints under SPEC.md's names. The shipped
-// block (0.5 x 1 m, elastic) under lambda = 0.3: e = lambda h / b = 0.6 at the end.
+// Through the program: `run --json` ends with the joints under the names of
+// docs/reference/output.md. The shipped block (0.5 x 1 m, elastic) under lambda = 0.3: e = lambda h
+// / b = 0.6 at the end.
 TEST(Thrust, RunJsonCarriesTheJoints) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / "voussoir_thrust_cli";

@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "drivers/capacity.hpp"
-#include "drivers/setup.hpp"
-#include "drivers/thrust.hpp"
+#include "commands/capacity.hpp"
+#include "engine/setup.hpp"
+#include "engine/thrust.hpp"
 #include "io/deck.hpp"
 #include "io/hdf5_output.hpp"
 #include "subprocess.hpp"

@@ -1,4 +1,4 @@
-// The pool of capacity trials (drivers/trial_pool.hpp): the search's results whatever ran
+// The pool of capacity trials (engine/trial_pool.hpp): the search's results whatever ran
 // ahead, a wrong guess cancelled, and a search whose trials and bracket do not depend on the
 // number of workers.
 
@@ -12,8 +12,8 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/capacity.hpp"
-#include "drivers/trial_pool.hpp"
+#include "commands/capacity.hpp"
+#include "engine/trial_pool.hpp"
 #include "io/deck.hpp"
 #include "same_search.hpp"
 

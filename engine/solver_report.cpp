@@ -1,0 +1,102 @@
+#include "engine/solver_report.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <mutex>
+
+namespace voussoir {
+
+namespace {
+
+std::mutex g_mutex;
+NscdStats g_record;
+
+}  // namespace
+
+void note_solver_runs(const NscdStats& end, const NscdStats& start) {
+  if (end.steps == start.steps) return;
+  const std::lock_guard<std::mutex> lock(g_mutex);
+  g_record.steps += end.steps - start.steps;
+  g_record.unconverged_steps += end.unconverged_steps - start.unconverged_steps;
+  g_record.iterations += end.iterations - start.iterations;
+  g_record.cone_steps += end.cone_steps - start.cone_steps;
+  // The run's largest values: those of the whole simulation, whose history before this run
+  // (a copied settled state) is part of the command's record anyway.
+  g_record.max_iterations = std::max(g_record.max_iterations, end.max_iterations);
+  g_record.max_residual = std::max(g_record.max_residual, end.max_residual);
+  g_record.max_penetration = std::max(g_record.max_penetration, end.max_penetration);
+}
+
+namespace {
+
+nlohmann::json stats_json(const NscdStats& r) {
+  return {r.steps,          r.unconverged_steps, r.iterations,     r.cone_steps,
+          r.max_iterations, r.max_residual,      r.max_penetration};
+}
+
+NscdStats stats_of(const nlohmann::json& j) {
+  NscdStats r;
+  r.steps = j.at(0);
+  r.unconverged_steps = j.at(1);
+  r.iterations = j.at(2);
+  r.cone_steps = j.at(3);
+  r.max_iterations = j.at(4);
+  r.max_residual = j.at(5);
+  r.max_penetration = j.at(6);
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json solver_runs_since(const NscdStats& start) {
+  return {{"start", stats_json(start)}, {"end", stats_json(solver_record())}};
+}
+
+void note_solver_runs(const nlohmann::json& runs) {
+  note_solver_runs(stats_of(runs.at("end")), stats_of(runs.at("start")));
+}
+
+NscdStats solver_record() {
+  const std::lock_guard<std::mutex> lock(g_mutex);
+  return g_record;
+}
+
+void reset_solver_record() {
+  const std::lock_guard<std::mutex> lock(g_mutex);
+  g_record = NscdStats{};
+}
+
+nlohmann::json solver_json(const Config& config, const NscdStats& r) {
+  if (config.solver.scheme != "nscd") return {{"scheme", config.solver.scheme}};
+  const double share = r.steps > 0 ? double(r.unconverged_steps) / double(r.steps) : 0.0;
+  return {{"scheme", "nscd"},
+          {"theta", config.solver.theta},
+          {"tolerance", config.solver.tolerance},
+          {"max_iterations", config.solver.max_iterations},
+          {"steps", r.steps},
+          {"iterations_mean", r.steps > 0 ? double(r.iterations) / double(r.steps) : 0.0},
+          {"iterations_max", r.max_iterations},
+          {"cone_steps", r.cone_steps},
+          {"unconverged_steps", r.unconverged_steps},
+          {"unconverged_share", share},
+          {"max_residual", r.max_residual},
+          {"max_interpenetration", r.max_penetration},
+          {"converged", !(share > kUnconvergedShare)}};
+}
+
+bool warn_unconverged(const Config& config, const NscdStats& r, bool quiet) {
+  if (config.solver.scheme != "nscd" || r.steps == 0) return false;
+  const double share = double(r.unconverged_steps) / double(r.steps);
+  if (!(share > kUnconvergedShare)) return false;
+  if (!quiet)
+    std::fprintf(stderr,
+                 "warning: the contact solver stopped at solver.max_iterations = %d before "
+                 "solver.tolerance = %g on %lld of %lld steps (%.1f%%, more than %.0f%%; largest "
+                 "residual %.3g): raise solver.max_iterations or solver.tolerance, or shorten "
+                 "solver.dt\n",
+                 config.solver.max_iterations, config.solver.tolerance, r.unconverged_steps,
+                 r.steps, 100.0 * share, 100.0 * kUnconvergedShare, r.max_residual);
+  return true;
+}
+
+}  // namespace voussoir
