@@ -1,7 +1,8 @@
 #pragma once
-// The validated contents of a deck (SPEC.md "Deck keys"). io/deck.cpp fills it from TOML and
-// `--set` overrides; everything downstream reads only this struct, never the TOML.
-// Defaults below are the defaults of a deck that omits the key.
+// The validated contents of a deck (the keys: docs/reference/deck.md). io/deck.cpp fills it from
+// TOML and `--set` overrides, one row of its key table per field; everything downstream reads
+// only this struct, never the TOML. The initialisers below are the defaults of a deck that omits
+// the key (the key table prints them from a default-constructed Config).
 // The ground header of the project (core/ includes nothing from io/, drivers/ or mesh/): the
 // deck schema and the error types every layer may throw or catch.
 
@@ -159,7 +160,7 @@ struct CapacityConfig {
   std::string mass_scaling = "equalize";
 };
 
-// [supports]: prescribed movements of fixed blocks (SPEC section 3; core/supports.hpp).
+// [supports]: prescribed movements of fixed blocks (docs/supports.md; core/supports.hpp).
 struct SupportMoveConfig {
   int block = 0;          // index of a fixed block (as `check --mesh-out` numbers them)
   double dx = 0.0;        // displacement of the block [m]

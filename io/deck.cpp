@@ -1,11 +1,12 @@
-// Deck reading and validation (SPEC.md "Deck keys").
+// Deck reading and validation: the key table (every deck key, its reader, its default and its
+// meaning; printed as docs/reference/deck.md by `voussoir keys`) and the walk of a deck.
 //
 // How a deck becomes a Config:
 //   1. the text is parsed by toml++ (a syntax error becomes "FILE:LINE:COL: TOML syntax error");
 //   2. each `--set KEY=VALUE` is parsed as a TOML value (a bare word that is not valid TOML is
 //      taken as a string) and inserted at its dotted path, replacing what the file said, so the
 //      overrides go through exactly the same validation as the file;
-//   3. the table is walked: every key must be one of the `kKeys` below (an unknown one is
+//   3. the table is walked: every key must be a row of key_table() below (an unknown one is
 //      reported with the nearest known key by edit distance); each key's reader checks the
 //      type and the range and stores the value;
 //   4. cross-key checks run last (required keys, lambda_min < lambda_max, input files exist).
@@ -34,6 +35,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -43,7 +45,7 @@
 
 namespace voussoir {
 
-// Whether `key` ("embrace" or "model.embrace") is among the keys of `section` the deck gave.
+// Whether `key` (embrace or model.embrace) is among the keys of `section` the deck gave.
 static bool section_has(const std::vector<std::string>& given, const std::string& section,
                         const std::string& key) {
   const std::string prefix = section + ".";
@@ -277,197 +279,441 @@ struct Reader {
   }
 };
 
-using Apply = void (*)(Reader&, const toml::node&, Config&);
+// ---------------------------------------------------------------------------------------------
+// The key table: one row per deck key, the only place a key's name is written. A row gives
+//   - the dotted name;
+//   - the Config field the key fills (core/schema.hpp: the field's initialiser is the default
+//     of a deck that omits the key);
+//   - its rule: the reader that checks the value and stores it (Number, Integer, Choice, ...).
+//     The rule also states the type, unit and allowed values (describe_key runs it in probing
+//     mode) and shows the field as a deck writes it (the default column, from a
+//     default-constructed Config);
+//   - one line of meaning.
+// `voussoir keys` and docs/reference/deck.md (io/deck_reference.cpp) print these rows; the
+// cross-key checks (check_together) name a key by its field (key_of). Adding a key: its field
+// and initialiser in core/schema.hpp, its row here, then `build/voussoir keys >
+// docs/reference/deck.md`.
+//
+// A rule reads a TOML value into a field of type T, `read(Reader, node, T&)`, and shows a value
+// of the field, `show(const T&)`.
+
+std::string quoted(const std::string& s) {
+  return "\"" + s + "\"";
+}
+
+template <typename List, typename F>
+std::string list(const List& items, F show) {
+  std::string s = "[";
+  for (std::size_t k = 0; k < items.size(); ++k) s += (k ? ", " : "") + show(items[k]);
+  return s + "]";
+}
+
+// A number in `range`. `unit`: "m", or the unit and what a value means ("m, 0 = automatic").
+// A field the rule would refuse (a stiffness of 0: not given) shows as "none".
+struct Number {
+  Range range;
+  const char* unit = nullptr;
+  void read(const Reader& r, const toml::node& n, double& v) const { v = r.number(n, range, unit); }
+  std::string show(double v) const { return inside(range, v) ? format_number(v) : "none"; }
+};
+
+// An integer in [lo, hi].
+struct Integer {
+  std::int64_t lo, hi;
+  void read(const Reader& r, const toml::node& n, int& v) const { v = r.integer(n, lo, hi); }
+  std::string show(int v) const { return std::to_string(v); }
+};
+
+// One of `allowed`.
+struct Choice {
+  std::vector<std::string> allowed;
+  void read(const Reader& r, const toml::node& n, std::string& v) const {
+    v = r.choice(n, allowed);
+  }
+  std::string show(const std::string& v) const { return quoted(v); }
+};
+
+// A key without a default: a deck must give it (check_together).
+template <typename Rule>
+struct Required : Rule {
+  template <typename T>
+  std::string show(const T&) const {
+    return "required";
+  }
+};
+
+// Any string; empty (the default): none.
+struct Text {
+  void read(const Reader& r, const toml::node& n, std::string& v) const { v = r.string(n); }
+  std::string show(const std::string& v) const { return v.empty() ? "none" : quoted(v); }
+};
+
+// A file the run reads (Reader::input_file); empty (the default): none.
+struct InputFile {
+  void read(const Reader& r, const toml::node& n, std::string& v) const { v = r.input_file(n); }
+  std::string show(const std::string& v) const { return v.empty() ? "none" : quoted(v); }
+};
+
+// model.spans: a non-empty array of numbers > 0.
+struct Spans {
+  void read(const Reader& r, const toml::node& n, std::vector<double>& spans) const {
+    const char* what = "a non-empty array of spans > 0 [m]";
+    const toml::array& a = r.array(n, what);
+    if (a.empty()) r.fail(n, what);
+    spans.clear();
+    for (const toml::node& e : a) {
+      const double v = e.is_number() ? e.value<double>().value_or(0.0) : 0.0;
+      if (!e.is_number() || !inside(above(0), v)) r.fail(n, what);
+      spans.push_back(v);
+    }
+  }
+  std::string show(const std::vector<double>& spans) const { return list(spans, format_number); }
+};
+
+// model.fixed: distinct block indices.
+struct BlockIndices {
+  void read(const Reader& r, const toml::node& n, std::vector<int>& fixed) const {
+    const char* what = "an array of distinct block indices (integers >= 0)";
+    const toml::array& a = r.array(n, what);
+    fixed.clear();
+    for (const toml::node& e : a) {
+      const auto* i = e.as_integer();
+      if (i == nullptr || i->get() < 0 || i->get() > std::numeric_limits<int>::max())
+        r.fail(n, what);
+      const int v = static_cast<int>(i->get());
+      if (std::find(fixed.begin(), fixed.end(), v) != fixed.end()) r.fail(n, what);
+      fixed.push_back(v);
+    }
+  }
+  std::string show(const std::vector<int>& fixed) const {
+    return list(fixed, [](int v) { return std::to_string(v); });
+  }
+};
+
+// solver.dt: "auto" (stored as 0) or a time step > 0.
+struct TimeStep {
+  void read(const Reader& r, const toml::node& n, double& dt) const {
+    const char* what = "\"auto\" or a time step > 0 [s]";
+    r.expects("\"auto\" or number", "s");
+    if (n.is_string() || (r.from_set(r.key) && !n.is_number())) {
+      if (r.string(n) != "auto") r.fail(n, what);
+      dt = 0.0;
+      return;
+    }
+    if (!n.is_number()) r.fail(n, what);
+    const double v = n.value<double>().value_or(0.0);
+    if (!inside(above(0), v)) r.fail(n, what);
+    dt = v;
+  }
+  std::string show(double dt) const { return dt == 0.0 ? quoted("auto") : format_number(dt); }
+};
+
+// load.base.band: [low, high] in Hz, or [0, 0].
+struct Band {
+  void read(const Reader& r, const toml::node& n, std::array<double, 2>& band) const {
+    const char* what = "[low, high] in Hz with 0 <= low < high, or [0, 0] for no filter";
+    const toml::array& a = r.array(n, what);
+    if (a.size() != 2 || !a[0].is_number() || !a[1].is_number()) r.fail(n, what);
+    const double lo = a[0].value<double>().value_or(0.0), hi = a[1].value<double>().value_or(0.0);
+    if (!std::isfinite(lo) || !std::isfinite(hi)) r.fail(n, what);
+    if (!(lo == 0.0 && hi == 0.0) && !(lo >= 0.0 && lo < hi)) r.fail(n, what);
+    band = {lo, hi};
+  }
+  std::string show(const std::array<double, 2>& band) const { return list(band, format_number); }
+};
+
+// supports.moves: an array of {block, dx, dy, rotation}; a bad field is named by its entry
+// ("supports.moves[1].dx").
+struct SupportMoves {
+  void read(const Reader& r, const toml::node& n, std::vector<SupportMoveConfig>& moves) const {
+    const char* what =
+        "an array of {block = B, dx = X, dy = Y, rotation = R} (B: a fixed block's index, "
+        "X, Y in m, R in degrees, |R| <= 90; dx, dy, rotation optional, 0 by default), each "
+        "block once";
+    const toml::array& a = r.array(n, what);
+    moves.clear();
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      const toml::node& e = *a.get(k);
+      const auto* t = e.as_table();
+      if (t == nullptr) r.fail(n, what);
+      const std::string entry = "supports.moves[" + std::to_string(k) + "].";
+      auto bad = [&](const std::string& field, const toml::node& v, const std::string& allowed) {
+        throw DeckError(one_line(r.where(r.key, &v) + entry + field + " = " + value_text(v) +
+                                 ": expected " + allowed));
+      };
+      SupportMoveConfig m;
+      if (!t->contains("block")) r.fail(n, what);
+      for (auto&& [name, v] : *t) {
+        const std::string field(name.str());
+        if (field == "block") {
+          const auto* i = v.as_integer();
+          if (i == nullptr || i->get() < 0 || i->get() > std::numeric_limits<int>::max())
+            bad(field, v, "a block index (an integer >= 0)");
+          m.block = static_cast<int>(i->get());
+          m.where = r.where(r.key, &v);
+          for (const SupportMoveConfig& o : moves)
+            if (o.block == m.block) bad(field, v, "each block at most once");
+          continue;
+        }
+        double* out = field == "dx"         ? &m.dx
+                      : field == "dy"       ? &m.dy
+                      : field == "rotation" ? &m.rotation
+                                            : nullptr;
+        if (out == nullptr) bad(field, v, "one of the fields block, dx, dy, rotation");
+        const auto* i = v.as_integer();
+        const auto* f = v.as_floating_point();
+        const double x = i ? static_cast<double>(i->get()) : f ? f->get() : NAN;
+        const bool angle = field == "rotation";
+        if (!std::isfinite(x) || (angle && !(std::abs(x) <= 90.0)))
+          bad(field, v, angle ? "a finite number of degrees in [-90, 90]" : "a finite number [m]");
+        *out = x;
+      }
+      moves.push_back(m);
+    }
+  }
+  std::string show(const std::vector<SupportMoveConfig>& moves) const {
+    return moves.empty() ? "[] (none)" : std::to_string(moves.size()) + " moves";
+  }
+};
+
+// output.fields: distinct names among "position", "velocity", "stress".
+struct OutputFields {
+  void read(const Reader& r, const toml::node& n, std::vector<std::string>& fields) const {
+    const char* what = "an array of distinct names among \"position\", \"velocity\", \"stress\"";
+    static const std::vector<std::string> allowed = {"position", "velocity", "stress"};
+    const toml::array& a = r.array(n, what);
+    fields.clear();
+    for (const toml::node& e : a) {
+      const auto* s = e.as_string();
+      if (s == nullptr || std::find(allowed.begin(), allowed.end(), s->get()) == allowed.end())
+        r.fail(n, what);
+      if (std::find(fields.begin(), fields.end(), s->get()) != fields.end()) r.fail(n, what);
+      fields.push_back(s->get());
+    }
+  }
+  std::string show(const std::vector<std::string>& fields) const { return list(fields, quoted); }
+};
+
 struct KeySpec {
+  // `field`: a generic lambda giving the address of the key's field in a Config (const or not).
+  template <typename Field, typename Rule>
+  KeySpec(const char* name, Field field, Rule rule, const char* what)
+      : key(name),
+        meaning(what),
+        read([=](Reader& r, const toml::node& n, Config& c) { rule.read(r, n, *field(c)); }),
+        show([=](const Config& c) { return rule.show(*field(c)); }),
+        address([=](const Config& c) -> const void* { return field(c); }) {}
   const char* key;
-  Apply apply;
+  const char* meaning;
+  std::function<void(Reader&, const toml::node&, Config&)> read;  // checks and stores a value
+  // The key's value in a Config, as a deck writes it.
+  std::function<std::string(const Config&)> show;
+  // Where the key's field is in a Config (key_of).
+  std::function<const void*(const Config&)> address;
 };
 
 const std::vector<std::string> kKinds = scene_kind_names();  // core/scene_kinds.hpp
 
-// Every key of the deck with its reader. Ranges are engineering limits: a value outside them
-// is a typing slip or a unit error (kPa for Pa, radians for degrees), never a real structure.
+// Every key of the deck in the reader's order (the order of the reference). Ranges are
+// engineering limits: a value outside them is a typing slip or a unit error (kPa for Pa,
+// radians for degrees), never a real structure. A data table: one row per key.
 const std::vector<KeySpec>& key_table() {
   static const std::vector<KeySpec> table = {
       // [model]
-      {"model.kind", [](Reader& r, const toml::node& n, Config& c) { c.model.kind = r.choice(n, kKinds); }},
-      {"model.radius", [](Reader& r, const toml::node& n, Config& c) { c.model.radius = r.number(n, above(0), "m"); }},
-      {"model.thickness", [](Reader& r, const toml::node& n, Config& c) { c.model.thickness = r.number(n, above(0), "m"); }},
-      {"model.embrace", [](Reader& r, const toml::node& n, Config& c) { c.model.embrace = r.number(n, {0, true, 360, true}, "deg"); }},
-      {"model.voussoirs", [](Reader& r, const toml::node& n, Config& c) { c.model.voussoirs = r.integer(n, 1, 100000); }},
-      {"model.offset", [](Reader& r, const toml::node& n, Config& c) { c.model.offset = r.number(n, at_least(0), "m"); }},
-      {"model.small_radius", [](Reader& r, const toml::node& n, Config& c) { c.model.small_radius = r.number(n, above(0), "m"); }},
-      {"model.shape", [](Reader& r, const toml::node& n, Config& c) { c.model.shape = r.choice(n, {"circular", "basket"}); }},
-      {"model.buttress_width", [](Reader& r, const toml::node& n, Config& c) { c.model.buttress_width = r.number(n, above(0), "m"); }},
-      {"model.base_depth", [](Reader& r, const toml::node& n, Config& c) { c.model.base_depth = r.number(n, above(0), "m"); }},
-      {"model.courses", [](Reader& r, const toml::node& n, Config& c) { c.model.courses = r.number(n, at_least(0), "m, 0 = monolithic"); }},
-      {"model.spans", [](Reader& r, const toml::node& n, Config& c) {
-         const char* what = "a non-empty array of spans > 0 [m]";
-         const toml::array& a = r.array(n, what);
-         if (a.empty()) r.fail(n, what);
-         c.model.spans.clear();
-         for (const toml::node& e : a) {
-           const double v = e.is_number() ? e.value<double>().value_or(0.0) : 0.0;
-           if (!e.is_number() || !inside(above(0), v)) r.fail(n, what);
-           c.model.spans.push_back(v);
-         }
-       }},
-      {"model.height", [](Reader& r, const toml::node& n, Config& c) { c.model.height = r.number(n, above(0), "m"); }},
-      {"model.pier_width", [](Reader& r, const toml::node& n, Config& c) { c.model.pier_width = r.number(n, above(0), "m"); }},
-      {"model.outer_width", [](Reader& r, const toml::node& n, Config& c) { c.model.outer_width = r.number(n, above(0), "m"); }},
-      {"model.eccentricity", [](Reader& r, const toml::node& n, Config& c) { c.model.eccentricity = r.number(n, {0, false, 2, false}); }},
-      {"model.voussoir_angle", [](Reader& r, const toml::node& n, Config& c) { c.model.voussoir_angle = r.number(n, {0, true, 90, true}, "deg"); }},
-      {"model.width", [](Reader& r, const toml::node& n, Config& c) { c.model.width = r.number(n, above(0), "m"); }},
-      {"model.incline", [](Reader& r, const toml::node& n, Config& c) { c.model.incline = r.number(n, {0, false, 90, true}, "deg"); }},
-      {"model.stack", [](Reader& r, const toml::node& n, Config& c) { c.model.stack = r.integer(n, 1, 1000); }},
-      {"model.file", [](Reader& r, const toml::node& n, Config& c) { c.model.file = r.input_file(n); }},
-      {"model.fixed", [](Reader& r, const toml::node& n, Config& c) {
-         const char* what = "an array of distinct block indices (integers >= 0)";
-         const toml::array& a = r.array(n, what);
-         c.model.fixed.clear();
-         for (const toml::node& e : a) {
-           const auto* i = e.as_integer();
-           if (i == nullptr || i->get() < 0 || i->get() > std::numeric_limits<int>::max())
-             r.fail(n, what);
-           const int v = static_cast<int>(i->get());
-           if (std::find(c.model.fixed.begin(), c.model.fixed.end(), v) != c.model.fixed.end())
-             r.fail(n, what);
-           c.model.fixed.push_back(v);
-         }
-       }},
-      {"model.out_of_plane", [](Reader& r, const toml::node& n, Config& c) { c.model.out_of_plane = r.number(n, above(0), "m"); }},
+      {"model.kind", [](auto& c) { return &c.model.kind; }, Required<Choice>{{kKinds}},
+       "scene: which structure the deck builds (the kinds: core/scene_kinds.hpp)"},
+      {"model.radius", [](auto& c) { return &c.model.radius; }, Number{above(0), "m"},
+       "arches: centreline radius Rc (basket: of the reference circle)"},
+      {"model.thickness", [](auto& c) { return &c.model.thickness; }, Number{above(0), "m"},
+       "arches and church: ring thickness t normal to the centreline (church default 0.5)"},
+      {"model.embrace", [](auto& c) { return &c.model.embrace; },
+       Number{{0, true, 360, true}, "deg"}, "arches: embrace angle beta of the arch"},
+      {"model.voussoirs", [](auto& c) { return &c.model.voussoirs; }, Integer{1, 100000},
+       "arches: number of voussoirs (blocks of equal centreline length)"},
+      {"model.offset", [](auto& c) { return &c.model.offset; }, Number{at_least(0), "m"},
+       "basket arch: offset d of the large arc's centre below O"},
+      {"model.small_radius", [](auto& c) { return &c.model.small_radius; }, Number{above(0), "m"},
+       "basket arch: radius r of the two small arcs"},
+      {"model.shape", [](auto& c) { return &c.model.shape; }, Choice{{"circular", "basket"}},
+       "buttressed arch: shape of the arch between the buttresses"},
+      {"model.buttress_width", [](auto& c) { return &c.model.buttress_width; },
+       Number{above(0), "m"}, "buttressed arch: buttress width B"},
+      {"model.base_depth", [](auto& c) { return &c.model.base_depth; }, Number{above(0), "m"},
+       "buttressed arch: depth H1 of the ground line below the centre O"},
+      {"model.courses", [](auto& c) { return &c.model.courses; },
+       Number{at_least(0), "m, 0 = monolithic"},
+       "buttressed arch and church: course height of the supports (0 = monolithic)"},
+      {"model.spans", [](auto& c) { return &c.model.spans; }, Spans{},
+       "church: clear spans of the three arches, left to right"},
+      {"model.height", [](auto& c) { return &c.model.height; }, Number{above(0), "m"},
+       "church: support height; block: block height (block default 1.0)"},
+      {"model.pier_width", [](auto& c) { return &c.model.pier_width; }, Number{above(0), "m"},
+       "church: width of the two inner piers"},
+      {"model.outer_width", [](auto& c) { return &c.model.outer_width; }, Number{above(0), "m"},
+       "church: width of the two outer buttresses"},
+      {"model.eccentricity", [](auto& c) { return &c.model.eccentricity; },
+       Number{{0, false, 2, false}},
+       "church: centre offset c of each pointed half-arch, as a fraction of half the span"},
+      {"model.voussoir_angle", [](auto& c) { return &c.model.voussoir_angle; },
+       Number{{0, true, 90, true}, "deg"},
+       "church: angle of the polar voussoirs about their centre"},
+      {"model.width", [](auto& c) { return &c.model.width; }, Number{above(0), "m"},
+       "block: block width"},
+      {"model.incline", [](auto& c) { return &c.model.incline; },
+       Number{{0, false, 90, true}, "deg"}, "block: incline of the fixed ground"},
+      {"model.stack", [](auto& c) { return &c.model.stack; }, Integer{1, 1000},
+       "block: number of blocks stacked on the ground"},
+      {"model.file", [](auto& c) { return &c.model.file; }, InputFile{},
+       "polygons: polygon text file or gmsh MSH 4.1 file of the blocks (docs/gmsh.md); a text "
+       "file's block must be a simple polygon with no corner sharper than 1 degree and no notch "
+       "narrower (refused naming the file's line, the block and the vertex; format: "
+       "mesh/scenes_polygons.cpp)"},
+      {"model.fixed", [](auto& c) { return &c.model.fixed; }, BlockIndices{},
+       "polygons: indices of the fixed blocks (file order; gmsh: physical tag order); other kinds: "
+       "blocks fixed besides the scene's supports (a pier to settle with [supports]); at least one "
+       "block must stay free"},
+      {"model.out_of_plane", [](auto& c) { return &c.model.out_of_plane; }, Number{above(0), "m"},
+       "out-of-plane thickness: masses and forces scale with it"},
       // [mesh]
-      {"mesh.chord_tolerance", [](Reader& r, const toml::node& n, Config& c) { c.mesh.chord_tolerance = r.number(n, {0, false, 1, false}, "x the block's thickness (rigid blocks)"); }},
-      {"mesh.max_triangles", [](Reader& r, const toml::node& n, Config& c) { c.mesh.max_triangles = r.integer(n, 1, 1000000000); }},
-      {"mesh.size", [](Reader& r, const toml::node& n, Config& c) { c.mesh.size = r.number(n, at_least(0), "m, 0 = use mesh.through_thickness"); }},
-      {"mesh.through_thickness", [](Reader& r, const toml::node& n, Config& c) { c.mesh.through_thickness = r.integer(n, 1, 1000); }},
+      {"mesh.chord_tolerance", [](auto& c) { return &c.mesh.chord_tolerance; },
+       Number{{0, false, 1, false}, "x the block's thickness (rigid blocks)"},
+       "rigid blocks: an outline point is dropped when its chord stays within this fraction of the "
+       "block's thickness"},
+      {"mesh.max_triangles", [](auto& c) { return &c.mesh.max_triangles; }, Integer{1, 1000000000},
+       "the most triangles a model may have; a deck whose mesh would exceed it is refused (exit 2) "
+       "before or while it is meshed"},
+      {"mesh.size", [](auto& c) { return &c.mesh.size; },
+       Number{at_least(0), "m, 0 = use mesh.through_thickness"},
+       "target element size (0: from mesh.through_thickness)"},
+      {"mesh.through_thickness", [](auto& c) { return &c.mesh.through_thickness; },
+       Integer{1, 1000}, "elements across the arch thickness (or the smallest block)"},
       // [material]
-      {"material.density", [](Reader& r, const toml::node& n, Config& c) { c.material.density = r.number(n, above(0), "kg/m3"); }},
-      {"material.young", [](Reader& r, const toml::node& n, Config& c) { c.material.young = r.number(n, above(0), "Pa"); }},
-      {"material.poisson", [](Reader& r, const toml::node& n, Config& c) { c.material.poisson = r.number(n, {0, false, 0.5, true}); }},
-      {"material.plane", [](Reader& r, const toml::node& n, Config& c) { c.material.plane = r.choice(n, {"strain", "stress"}); }},
-      {"material.model", [](Reader& r, const toml::node& n, Config& c) { c.material.model = r.choice(n, {"elastic", "rigid"}); }},
+      {"material.density", [](auto& c) { return &c.material.density; }, Number{above(0), "kg/m3"},
+       "mass density rho of the blocks"},
+      {"material.young", [](auto& c) { return &c.material.young; }, Number{above(0), "Pa"},
+       "Young's modulus E of the blocks"},
+      {"material.poisson", [](auto& c) { return &c.material.poisson; },
+       Number{{0, false, 0.5, true}}, "Poisson's ratio nu of the blocks"},
+      {"material.plane", [](auto& c) { return &c.material.plane; }, Choice{{"strain", "stress"}},
+       "plane strain or plane stress"},
+      {"material.model", [](auto& c) { return &c.material.model; }, Choice{{"elastic", "rigid"}},
+       "elastic: constant-strain triangles; rigid: one rigid body per block (docs/rigid.md)"},
       // [contact]
-      {"contact.friction", [](Reader& r, const toml::node& n, Config& c) { c.contact.friction = r.number(n, at_least(0)); }},
-      {"contact.penalty_factor", [](Reader& r, const toml::node& n, Config& c) { c.contact.penalty_factor = r.number(n, above(0), "x Lame's first constant"); }},
-      {"contact.penalty", [](Reader& r, const toml::node& n, Config& c) { c.contact.penalty = r.number(n, at_least(0), "Pa, 0 = use contact.penalty_factor"); }},
-      {"contact.buffer", [](Reader& r, const toml::node& n, Config& c) { c.contact.buffer = r.number(n, at_least(0), "m, 0 = automatic"); }},
-      {"contact.normal_stiffness", [](Reader& r, const toml::node& n, Config& c) { c.contact.normal_stiffness = r.number(n, above(0), "N/m3"); }},
-      {"contact.shear_stiffness", [](Reader& r, const toml::node& n, Config& c) { c.contact.shear_stiffness = r.number(n, above(0), "N/m3"); }},
-      {"contact.restitution", [](Reader& r, const toml::node& n, Config& c) { c.contact.restitution = r.number(n, {0, false, 1, false}, "coefficient of restitution"); }},
+      {"contact.friction", [](auto& c) { return &c.contact.friction; }, Number{at_least(0)},
+       "Coulomb friction coefficient mu of the joints"},
+      {"contact.penalty_factor", [](auto& c) { return &c.contact.penalty_factor; },
+       Number{above(0), "x Lame's first constant"},
+       "contact penalty Ep as a multiple of Lame's first constant"},
+      {"contact.penalty", [](auto& c) { return &c.contact.penalty; },
+       Number{at_least(0), "Pa, 0 = use contact.penalty_factor"},
+       "contact penalty Ep as a value (0: from contact.penalty_factor)"},
+      {"contact.buffer", [](auto& c) { return &c.contact.buffer; },
+       Number{at_least(0), "m, 0 = automatic"}, "NBS contact search buffer (0: automatic)"},
+      {"contact.normal_stiffness", [](auto& c) { return &c.contact.normal_stiffness; },
+       Number{above(0), "N/m3"},
+       "joint normal stiffness kn, replaces the penalty (not given: penalty, or 100 E / L for "
+       "rigid blocks, L the joint's length)"},
+      {"contact.shear_stiffness", [](auto& c) { return &c.contact.shear_stiffness; },
+       Number{above(0), "N/m3"}, "joint shear stiffness ks (not given: kn / 4)"},
+      {"contact.restitution", [](auto& c) { return &c.contact.restitution; },
+       Number{{0, false, 1, false}, "coefficient of restitution"},
+       "impact restitution of rigid blocks (1: no impact damping; below 1 needs material.model = "
+       "\"rigid\"; not given: 0.5 for rigid blocks in run, pulse, stability and capacity "
+       "--dynamic, none in the quasi-static capacity trials; nscd: 0, plastic impacts)"},
       // [solver]
-      {"solver.dt", [](Reader& r, const toml::node& n, Config& c) {
-         const char* what = "\"auto\" or a time step > 0 [s]";
-         r.expects("\"auto\" or number", "s");
-         if (n.is_string() || (r.from_set(r.key) && !n.is_number())) {
-           if (r.string(n) != "auto") r.fail(n, what);
-           c.solver.dt = 0.0;
-           return;
-         }
-         if (!n.is_number()) r.fail(n, what);
-         const double v = n.value<double>().value_or(0.0);
-         if (!inside(above(0), v)) r.fail(n, what);
-         c.solver.dt = v;
-       }},
-      {"solver.dt_safety", [](Reader& r, const toml::node& n, Config& c) { c.solver.dt_safety = r.number(n, {0, true, 1, false}); }},
-      {"solver.damping_factor", [](Reader& r, const toml::node& n, Config& c) { c.solver.damping_factor = r.number(n, at_least(0)); }},
-      {"solver.end_time", [](Reader& r, const toml::node& n, Config& c) { c.solver.end_time = r.number(n, above(0), "s"); }},
-      {"solver.scheme", [](Reader& r, const toml::node& n, Config& c) { c.solver.scheme = r.choice(n, {"explicit", "nscd"}); }},
-      {"solver.theta", [](Reader& r, const toml::node& n, Config& c) { c.solver.theta = r.number(n, {0.5, false, 1, false}); }},
-      {"solver.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.solver.tolerance = r.number(n, above(0), "x the step's velocity scale"); }},
-      {"solver.max_iterations", [](Reader& r, const toml::node& n, Config& c) { c.solver.max_iterations = r.integer(n, 1, 100000000); }},
+      {"solver.dt", [](auto& c) { return &c.solver.dt; }, TimeStep{},
+       "time step: \"auto\" (explicit: stable limit x solver.dt_safety; nscd: 1e-3 s, or a "
+       "record's sampling interval if shorter) or a value"},
+      {"solver.dt_safety", [](auto& c) { return &c.solver.dt_safety; }, Number{{0, true, 1, false}},
+       "fraction of the stable time step that \"auto\" uses"},
+      {"solver.damping_factor", [](auto& c) { return &c.solver.damping_factor; },
+       Number{at_least(0)}, "scales the element viscosity eta = 2 h sqrt(E rho)"},
+      {"solver.end_time", [](auto& c) { return &c.solver.end_time; }, Number{above(0), "s"},
+       "simulated time of `run`"},
+      {"solver.scheme", [](auto& c) { return &c.solver.scheme; }, Choice{{"explicit", "nscd"}},
+       "time scheme: explicit central difference, or nscd: rigid blocks by non-smooth contact "
+       "dynamics, rigid joints (needs material.model = \"rigid\"; docs/nscd.md)"},
+      {"solver.theta", [](auto& c) { return &c.solver.theta; }, Number{{0.5, false, 1, false}},
+       "nscd: Moreau-Jean's theta (0.5: no numerical dissipation)"},
+      {"solver.tolerance", [](auto& c) { return &c.solver.tolerance; },
+       Number{above(0), "x the step's velocity scale"},
+       "nscd: the Gauss-Seidel stops when a sweep changes no body's velocity by more than this "
+       "times h |a| or the fastest approach (docs/nscd.md)"},
+      {"solver.max_iterations", [](auto& c) { return &c.solver.max_iterations; },
+       Integer{1, 100000000},
+       "nscd: most Gauss-Seidel sweeps a step (a step that reaches it is counted unconverged)"},
       // [load]
-      {"load.gravity", [](Reader& r, const toml::node& n, Config& c) { c.load.gravity = r.number(n, at_least(0), "m/s2"); }},
-      {"load.lambda", [](Reader& r, const toml::node& n, Config& c) { c.load.lambda = r.number(n, any_finite(), "x gravity"); }},
-      {"load.gravity_ramp", [](Reader& r, const toml::node& n, Config& c) { c.load.gravity_ramp = r.number(n, at_least(0), "s"); }},
+      {"load.gravity", [](auto& c) { return &c.load.gravity; }, Number{at_least(0), "m/s2"},
+       "gravity g, downward (0: a weightless deck, which only `check` and `run` take)"},
+      {"load.lambda", [](auto& c) { return &c.load.lambda; }, Number{any_finite(), "x gravity"},
+       "horizontal body load factor of `run` (x gravity)"},
+      {"load.gravity_ramp", [](auto& c) { return &c.load.gravity_ramp; }, Number{at_least(0), "s"},
+       "`run`: gravity and lambda g brought on together, linearly, over this time (0: from t = 0; "
+       "a structure loaded over a time long against its slowest mode starts its history at rest: "
+       "docs/rigid.md)"},
       // [load.base]
-      {"load.base.signal", [](Reader& r, const toml::node& n, Config& c) { c.load.base.signal = r.choice(n, {"none", "windowed_sine", "sine_pulse", "file"}); }},
-      {"load.base.amplitude", [](Reader& r, const toml::node& n, Config& c) { c.load.base.amplitude = r.number(n, any_finite(), "g"); }},
-      {"load.base.frequency", [](Reader& r, const toml::node& n, Config& c) { c.load.base.frequency = r.number(n, above(0), "Hz"); }},
-      {"load.base.cycles", [](Reader& r, const toml::node& n, Config& c) { c.load.base.cycles = r.integer(n, 1, 1000); }},
-      {"load.base.file", [](Reader& r, const toml::node& n, Config& c) { c.load.base.file = r.input_file(n); }},
-      {"load.base.units", [](Reader& r, const toml::node& n, Config& c) { c.load.base.units = r.choice(n, {"g", "m/s2"}); }},
-      {"load.base.baseline", [](Reader& r, const toml::node& n, Config& c) { c.load.base.baseline = r.choice(n, {"none", "constant", "linear", "quadratic"}); }},
-      {"load.base.band", [](Reader& r, const toml::node& n, Config& c) {
-         const char* what = "[low, high] in Hz with 0 <= low < high, or [0, 0] for no filter";
-         const toml::array& a = r.array(n, what);
-         if (a.size() != 2 || !a[0].is_number() || !a[1].is_number()) r.fail(n, what);
-         const double lo = a[0].value<double>().value_or(0.0), hi = a[1].value<double>().value_or(0.0);
-         if (!std::isfinite(lo) || !std::isfinite(hi)) r.fail(n, what);
-         if (!(lo == 0.0 && hi == 0.0) && !(lo >= 0.0 && lo < hi)) r.fail(n, what);
-         c.load.base.band = {lo, hi};
-       }},
+      {"load.base.signal", [](auto& c) { return &c.load.base.signal; },
+       Choice{{"none", "windowed_sine", "sine_pulse", "file"}},
+       "base acceleration history of `pulse` (`run` does not apply it)"},
+      {"load.base.amplitude", [](auto& c) { return &c.load.base.amplitude; },
+       Number{any_finite(), "g"}, "peak base acceleration A"},
+      {"load.base.frequency", [](auto& c) { return &c.load.base.frequency; },
+       Number{above(0), "Hz"}, "pulse frequency f"},
+      {"load.base.cycles", [](auto& c) { return &c.load.base.cycles; }, Integer{1, 1000},
+       "windowed sine: number of cycles"},
+      {"load.base.file", [](auto& c) { return &c.load.base.file; }, InputFile{},
+       "signal = \"file\": two-column accelerogram (time, acceleration) or PEER NGA .AT2 record "
+       "(docs/records.md)"},
+      {"load.base.units", [](auto& c) { return &c.load.base.units; }, Choice{{"g", "m/s2"}},
+       "units of the accelerogram's acceleration column"},
+      {"load.base.baseline", [](auto& c) { return &c.load.base.baseline; },
+       Choice{{"none", "constant", "linear", "quadratic"}},
+       "baseline correction of the accelerogram before the band-pass: the degree of the polynomial "
+       "removed from the acceleration, fitted to the displacement (docs/records.md)"},
+      {"load.base.band", [](auto& c) { return &c.load.base.band; }, Band{},
+       "band-pass filter of the accelerogram [low, high] ([0, 0]: none)"},
       // [capacity]
-      {"capacity.lambda_min", [](Reader& r, const toml::node& n, Config& c) { c.capacity.lambda_min = r.number(n, at_least(0)); }},
-      {"capacity.lambda_max", [](Reader& r, const toml::node& n, Config& c) { c.capacity.lambda_max = r.number(n, at_least(0)); }},
-      {"capacity.local_damping", [](Reader& r, const toml::node& n, Config& c) { c.capacity.local_damping = r.number(n, {0, false, 1, true}, "local damping coefficient of the quasi-static trials"); }},
-      {"capacity.local_damping_mode", [](Reader& r, const toml::node& n, Config& c) { c.capacity.local_damping_mode = r.choice(n, {"outgoing", "full"}); }},
-      {"capacity.kinetic_damping", [](Reader& r, const toml::node& n, Config& c) { c.capacity.kinetic_damping = r.number(n, {0, false, 1, true}, "fraction of the peak kinetic energy"); }},
-      {"capacity.mass_scaling", [](Reader& r, const toml::node& n, Config& c) { c.capacity.mass_scaling = r.choice(n, {"equalize", "none"}); }},
-      {"capacity.tolerance", [](Reader& r, const toml::node& n, Config& c) { c.capacity.tolerance = r.number(n, {0, true, 1, true}, "relative bracket width"); }},
+      {"capacity.lambda_min", [](auto& c) { return &c.capacity.lambda_min; }, Number{at_least(0)},
+       "lower end of the starting bracket of `capacity` (stable); above 0, checked by a trial "
+       "beside lambda_max's (a collapse there widens the bracket down)"},
+      {"capacity.lambda_max", [](auto& c) { return &c.capacity.lambda_max; }, Number{at_least(0)},
+       "upper end of the starting bracket (both 0: from limit analysis); checked by a trial"},
+      {"capacity.local_damping", [](auto& c) { return &c.capacity.local_damping; },
+       Number{{0, false, 1, true}, "local damping coefficient of the quasi-static trials"},
+       "coefficient of the local damping of the quasi-static settle and trials of `capacity` and "
+       "`sweep` (0: none; `--dynamic`: off; docs/capacity.md)"},
+      {"capacity.local_damping_mode", [](auto& c) { return &c.capacity.local_damping_mode; },
+       Choice{{"outgoing", "full"}},
+       "outgoing: damp only while the force opposes the motion (a mechanism is not slowed); full: "
+       "Cundall's rule at every step"},
+      {"capacity.kinetic_damping", [](auto& c) { return &c.capacity.kinetic_damping; },
+       Number{{0, false, 1, true}, "fraction of the peak kinetic energy"},
+       "kinetic damping of the same phases: every velocity set to zero once the kinetic energy has "
+       "fallen this fraction below its peak (0: none; `--dynamic`: off; docs/capacity.md)"},
+      {"capacity.mass_scaling", [](auto& c) { return &c.capacity.mass_scaling; },
+       Choice{{"equalize", "none"}},
+       "rigid blocks in the same phases: equalize lowers the mass and inertia of each block until "
+       "its own stable step is the model's (loads keep the true masses); none: true inertia "
+       "(`--dynamic`: none; docs/capacity.md)"},
+      {"capacity.tolerance", [](auto& c) { return &c.capacity.tolerance; },
+       Number{{0, true, 1, true}, "relative bracket width"},
+       "relative width of the final bracket: (hi - lo) / hi"},
       // [supports]
-      {"supports.moves", [](Reader& r, const toml::node& n, Config& c) {
-         const char* what =
-             "an array of {block = B, dx = X, dy = Y, rotation = R} (B: a fixed block's index, "
-             "X, Y in m, R in degrees, |R| <= 90; dx, dy, rotation optional, 0 by default), each block once";
-         const toml::array& a = r.array(n, what);
-         c.supports.moves.clear();
-         for (std::size_t k = 0; k < a.size(); ++k) {
-           const toml::node& e = *a.get(k);
-           const auto* t = e.as_table();
-           if (t == nullptr) r.fail(n, what);
-           const std::string entry = "supports.moves[" + std::to_string(k) + "].";
-           auto bad = [&](const std::string& field, const toml::node& v, const std::string& allowed) {
-             throw DeckError(one_line(r.where(r.key, &v) + entry + field + " = " + value_text(v) +
-                                      ": expected " + allowed));
-           };
-           SupportMoveConfig m;
-           if (!t->contains("block")) r.fail(n, what);
-           for (auto&& [name, v] : *t) {
-             const std::string field(name.str());
-             if (field == "block") {
-               const auto* i = v.as_integer();
-               if (i == nullptr || i->get() < 0 || i->get() > std::numeric_limits<int>::max())
-                 bad(field, v, "a block index (an integer >= 0)");
-               m.block = static_cast<int>(i->get());
-               m.where = r.where(r.key, &v);
-               for (const SupportMoveConfig& o : c.supports.moves)
-                 if (o.block == m.block) bad(field, v, "each block at most once");
-               continue;
-             }
-             double* out = field == "dx" ? &m.dx : field == "dy" ? &m.dy
-                                        : field == "rotation" ? &m.rotation : nullptr;
-             if (out == nullptr) bad(field, v, "one of the fields block, dx, dy, rotation");
-             const auto* i = v.as_integer();
-             const auto* f = v.as_floating_point();
-             const double x = i ? static_cast<double>(i->get()) : f ? f->get() : NAN;
-             const bool angle = field == "rotation";
-             if (!std::isfinite(x) || (angle && !(std::abs(x) <= 90.0)))
-               bad(field, v, angle ? "a finite number of degrees in [-90, 90]"
-                                   : "a finite number [m]");
-             *out = x;
-           }
-           c.supports.moves.push_back(m);
-         }
-       }},
-      {"supports.ramp", [](Reader& r, const toml::node& n, Config& c) { c.supports.ramp = r.number(n, above(0), "s"); }},
+      {"supports.moves", [](auto& c) { return &c.supports.moves; }, SupportMoves{},
+       "prescribed movements of fixed blocks: block (its number in `check`, which lists the "
+       "supports), dx, dy [m] and rotation [deg, counter-clockwise about its centroid]; every "
+       "command settles under gravity, moves them over `ramp`, then runs on the moved structure "
+       "(`run`: from t = 0; docs/supports.md)"},
+      {"supports.ramp", [](auto& c) { return &c.supports.ramp; }, Number{above(0), "s"},
+       "time over which the moves are reached, by a ramp with zero velocity and acceleration at "
+       "both ends (docs/supports.md)"},
       // [output]
-      {"output.file", [](Reader& r, const toml::node& n, Config& c) { c.output.file = r.string(n); }},
-      {"output.every", [](Reader& r, const toml::node& n, Config& c) { c.output.every = r.number(n, above(0), "s"); }},
-      {"output.fields", [](Reader& r, const toml::node& n, Config& c) {
-         const char* what = "an array of distinct names among \"position\", \"velocity\", \"stress\"";
-         static const std::vector<std::string> allowed = {"position", "velocity", "stress"};
-         const toml::array& a = r.array(n, what);
-         c.output.fields.clear();
-         for (const toml::node& e : a) {
-           const auto* s = e.as_string();
-           if (s == nullptr || std::find(allowed.begin(), allowed.end(), s->get()) == allowed.end())
-             r.fail(n, what);
-           if (std::find(c.output.fields.begin(), c.output.fields.end(), s->get()) != c.output.fields.end())
-             r.fail(n, what);
-           c.output.fields.push_back(s->get());
-         }
-       }},
+      {"output.file", [](auto& c) { return &c.output.file; }, Text{},
+       "HDF5 file of `run` / `pulse` (XDMF beside it); empty: none"},
+      {"output.every", [](auto& c) { return &c.output.every; }, Number{above(0), "s"},
+       "snapshot interval"},
+      {"output.fields", [](auto& c) { return &c.output.fields; }, OutputFields{},
+       "snapshot fields: position (with displacement), velocity, stress (elastic blocks)"},
   };
   return table;
 }
@@ -504,9 +750,9 @@ std::string section_of(const std::string& dotted) {
 
 // The known key (or section) nearest to an unknown one, or "" when nothing is close.
 // Score of a candidate: the edit distance of the whole dotted path, or, for a key of another
-// section, the distance of the key names plus one (so "model.frction" finds
-// "contact.friction"). Close enough to be a slip: at most one edit per four characters of the
-// name, and two edits are always allowed.
+// section, the distance of the key names plus one (so model.frction finds contact.friction). Close
+// enough to be a slip: at most one edit per four characters of the name, and two edits are always
+// allowed.
 std::string suggest(const std::string& unknown) {
   const std::string leaf = leaf_of(unknown), section = section_of(unknown);
   std::string best;
@@ -571,7 +817,7 @@ void walk(Reader& r, const toml::table& table, const std::string& prefix, Config
     if (spec != nullptr) {
       r.key = dotted;
       r.seen[dotted] = &v;
-      spec->apply(r, v, config);
+      spec->read(r, v, config);
       continue;
     }
     if (sections().count(dotted) != 0) {
@@ -654,22 +900,33 @@ void apply_override(Reader& r, toml::table& root, const std::string& text) {
   mark_set_subtree(r, key, value, raw);
 }
 
+// The key whose field is at `field` in `c` (a field of one row of key_table()). The cross-key
+// checks below name a key by its field, so that its name is written in its row only.
+std::string key_of(const Config& c, const void* field) {
+  for (const KeySpec& k : key_table())
+    if (k.address(c) == field) return k.key;
+  throw std::logic_error("key_of: a Config field that no row of the key table reads");
+}
+
 // Cross-key checks, after every key has been read.
 void check_together(const Reader& r, Config& c) {
+  auto key = [&](const auto& field) { return key_of(c, &field); };
   auto given = [&](const std::string& k) { return r.seen.count(k) != 0; };
-  if (!given("model.kind"))
-    throw DeckError(r.source + ": missing required key 'model.kind' (one of " + join(kKinds) + ")");
+  const std::string kind_key = key(c.model.kind);
+  if (!given(kind_key))
+    throw DeckError(r.source + ": missing required key '" + kind_key + "' (one of " + join(kKinds) +
+                    ")");
   const SceneKind* kind = find_scene_kind(c.model.kind);  // known: read by r.choice(kKinds)
   for (const RequiredKey& req : kind ? kind->required : std::vector<RequiredKey>{})
     if (!given(req.key))
-      throw DeckError(r.where("model.kind", r.seen.at("model.kind")) + "missing required key '" +
-                      req.key + "' (model.kind = \"" + c.model.kind + "\" " + req.why + ")");
-  if (c.load.base.signal == "file" && !given("load.base.file"))
-    throw DeckError(r.where("load.base.signal", r.seen.at("load.base.signal")) +
-                    "missing required key 'load.base.file' (load.base.signal = \"file\" reads a "
-                    "two-column or PEER .AT2 accelerogram from it)");
+      throw DeckError(r.where(kind_key, r.seen.at(kind_key)) + "missing required key '" + req.key +
+                      "' (" + kind_key + " = \"" + c.model.kind + "\" " + req.why + ")");
+  const std::string signal = key(c.load.base.signal), record = key(c.load.base.file);
+  if (c.load.base.signal == "file" && !given(record))
+    throw DeckError(r.where(signal, r.seen.at(signal)) + "missing required key '" + record + "' (" +
+                    signal + " = \"file\" reads a two-column or PEER .AT2 accelerogram from it)");
   // Input files the run will read must be there now, not an hour into a sweep.
-  auto readable = [&](const std::string& key, const std::string& path) {
+  auto readable = [&](const std::string& k, const std::string& path) {
     std::error_code ec;
     std::string why;
     if (!fs::exists(path, ec)) {
@@ -681,15 +938,16 @@ void check_together(const Reader& r, Config& c) {
       if (!in) why = std::strerror(errno);
     }
     if (!why.empty()) {
-      const toml::node* n = r.seen.at(key);
-      throw DeckError(one_line(r.where(key, n) + key + " = " + value_text(*n) + ": cannot read '" +
+      const toml::node* n = r.seen.at(k);
+      throw DeckError(one_line(r.where(k, n) + k + " = " + value_text(*n) + ": cannot read '" +
                                path + "' (" + why + ")"));
     }
   };
   // A joint stiffness replaces the penalty: both at once is a contradiction.
-  for (const char* stiff : {"contact.normal_stiffness", "contact.shear_stiffness"}) {
+  for (const std::string& stiff :
+       {key(c.contact.normal_stiffness), key(c.contact.shear_stiffness)}) {
     if (!given(stiff)) continue;
-    for (const char* pen : {"contact.penalty", "contact.penalty_factor"}) {
+    for (const std::string& pen : {key(c.contact.penalty), key(c.contact.penalty_factor)}) {
       if (!given(pen)) continue;
       const toml::node* n = r.seen.at(stiff);
       throw DeckError(one_line(r.where(stiff, n) + stiff + " = " + value_text(*n) + " and " + pen +
@@ -698,15 +956,17 @@ void check_together(const Reader& r, Config& c) {
     }
   }
   if (c.solver.scheme == "nscd" && c.material.model != "rigid") {
-    const toml::node* n = r.seen.at("solver.scheme");
-    throw DeckError(one_line(r.where("solver.scheme", n) + "solver.scheme = " + value_text(*n) +
+    const std::string scheme = key(c.solver.scheme);
+    const toml::node* n = r.seen.at(scheme);
+    throw DeckError(one_line(r.where(scheme, n) + scheme + " = " + value_text(*n) +
                              ": non-smooth contact dynamics needs material.model = \"rigid\" "
-                             "(material.model = \"" + c.material.model + "\")"));
+                             "(material.model = \"" +
+                             c.material.model + "\")"));
   }
-  if (given("contact.restitution") && c.contact.restitution < 1.0 && c.material.model != "rigid") {
-    const toml::node* n = r.seen.at("contact.restitution");
-    throw DeckError(one_line(r.where("contact.restitution", n) + "contact.restitution = " +
-                             value_text(*n) +
+  const std::string restitution = key(c.contact.restitution);
+  if (given(restitution) && c.contact.restitution < 1.0 && c.material.model != "rigid") {
+    const toml::node* n = r.seen.at(restitution);
+    throw DeckError(one_line(r.where(restitution, n) + restitution + " = " + value_text(*n) +
                              ": impact damping needs material.model = \"rigid\" (elastic blocks "
                              "allow only 1)"));
   }
@@ -715,18 +975,17 @@ void check_together(const Reader& r, Config& c) {
   std::vector<std::string> reads;
   for (const RequiredKey& req : kind ? kind->required : std::vector<RequiredKey>{})
     reads.emplace_back(req.key);
-  if (c.load.base.signal == "file") reads.emplace_back("load.base.file");
-  for (const std::string& key : reads) {
-    const auto it = r.input_files.find(key);
-    if (it != r.input_files.end()) readable(key, it->second);
+  if (c.load.base.signal == "file") reads.emplace_back(record);
+  for (const std::string& k : reads) {
+    const auto it = r.input_files.find(k);
+    if (it != r.input_files.end()) readable(k, it->second);
   }
-  if (given("capacity.lambda_min") && given("capacity.lambda_max") &&
-      !(c.capacity.lambda_min == 0.0 && c.capacity.lambda_max == 0.0) &&
+  const std::string lo = key(c.capacity.lambda_min), hi = key(c.capacity.lambda_max);
+  if (given(lo) && given(hi) && !(c.capacity.lambda_min == 0.0 && c.capacity.lambda_max == 0.0) &&
       !(c.capacity.lambda_min < c.capacity.lambda_max)) {
-    const toml::node* n = r.seen.at("capacity.lambda_min");
-    throw DeckError(one_line(r.where("capacity.lambda_min", n) + "capacity.lambda_min = " +
-                             value_text(*n) + ": expected a number < capacity.lambda_max = " +
-                             value_text(*r.seen.at("capacity.lambda_max"))));
+    const toml::node* n = r.seen.at(lo);
+    throw DeckError(one_line(r.where(lo, n) + lo + " = " + value_text(*n) +
+                             ": expected a number < " + hi + " = " + value_text(*r.seen.at(hi))));
   }
 }
 
@@ -735,6 +994,14 @@ void check_together(const Reader& r, Config& c) {
 KeyRule describe_key(const std::string& key) {
   const KeySpec* spec = find_key(key);
   if (spec == nullptr) throw std::invalid_argument("describe_key: unknown deck key " + key);
+  KeyRule rule;
+  rule.meaning = spec->meaning;
+  static const Config defaults;
+  rule.default_value = spec->show(defaults);
+  // Keys a scene kind cannot do without (core/scene_kinds.hpp).
+  for (const SceneKind& k : scene_kinds())
+    for (const RequiredKey& req : k.required)
+      if (key == req.key) rule.default_value = "required by kind \"" + std::string(k.name) + "\"";
   Reader r;
   r.probing = true;
   r.source = "(probe)";
@@ -742,9 +1009,11 @@ KeyRule describe_key(const std::string& key) {
   const toml::table probe;
   Config scratch;
   try {
-    spec->apply(r, probe, scratch);
+    spec->read(r, probe, scratch);
   } catch (const KeyProbe& p) {
-    KeyRule rule{p.type, p.unit, p.allowed};
+    rule.type = p.type;
+    rule.unit = p.unit;
+    rule.allowed = p.allowed;
     // "a number > 0 [m, 0 = automatic]" -> allowed "a number > 0; 0 = automatic", unit "m".
     const std::string suffix = " [" + p.unit + "]";
     if (!p.unit.empty() && rule.allowed.size() >= suffix.size() &&
@@ -754,9 +1023,9 @@ KeyRule describe_key(const std::string& key) {
       rule.allowed += "; " + p.unit.substr(comma + 2);
       rule.unit = p.unit.substr(0, comma);
     }
-    return rule;
   }
-  return {};  // the reader took a table: no rule to show (the reference test refuses this)
+  // A reader that took a table leaves type and allowed empty (the reference tests refuse it).
+  return rule;
 }
 
 const std::vector<std::string>& known_keys() {
@@ -791,8 +1060,7 @@ Config parse_deck(const std::string& text, const std::string& source,
   walk(r, root, "", config);
   check_together(r, config);
   // Rigid blocks carry no element stress: the field is not written (`check` says so).
-  if (config.material.model == "rigid")
-    std::erase(config.output.fields, std::string("stress"));
+  if (config.material.model == "rigid") std::erase(config.output.fields, std::string("stress"));
   for (const auto& [k, n] : r.seen) {
     if (k.rfind("model.", 0) == 0) config.model.given.push_back(k.substr(6));
     if (k.rfind("contact.", 0) == 0) config.contact.given.push_back(k.substr(8));
