@@ -1,5 +1,5 @@
 #pragma once
-// Gravity-only stability maps (SPEC.md section 2, `voussoir stability`; docs/dynamics.md
+// Gravity-only stability maps (SPEC.md section 2, `voussoir stability`; docs/stability.md
 // "Gilbert arch stability map").
 //
 // A cell of the map is one deck (the base deck with the cell's `--param` values applied) run
