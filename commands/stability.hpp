@@ -1,5 +1,5 @@
 #pragma once
-// Gravity-only stability maps (docs/reference/commands.md, `voussoir stability`; docs/dynamics.md
+// Gravity-only stability maps (docs/reference/commands.md, `voussoir stability`; docs/stability.md
 // "Gilbert arch stability map").
 //
 // A cell of the map is one deck (the base deck with the cell's `--param` values applied) run

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The studies under `mpirun -n 2` against one process (docs/reference/commands.md, docs/mpi.md). ctest runs it
+"""The studies under `mpirun -n 2` against one process (docs/mpi.md). ctest runs it
 three times, labelled `mpi`, where the program is built with MPI:
 
   --part same     a 12-cell sweep (cases/block.toml, friction x width), a 16-cell corner of the

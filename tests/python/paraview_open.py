@@ -1,8 +1,8 @@
-"""Opens a run's .xdmf in ParaView as a user would, with no workaround (docs/output.md): with the
-XDMF Reader, Xdmf3ReaderS and Xdmf3ReaderT, by a relative name from another working directory;
-checks every step has a time, the point vectors have 3 components and the stress is named
-scalars; applies Warp By Vector on `displacement` and saves a screenshot (under Xvfb when
-there is no display).
+"""Opens a run's .xdmf in ParaView as a user would, with no workaround (docs/guide/results.md,
+docs/reference/output.md): with the XDMF Reader, Xdmf3ReaderS and Xdmf3ReaderT, by a relative
+name from another working directory; checks every step has a time, the point vectors have 3
+components and the stress is named scalars; applies Warp By Vector on `displacement` and saves a
+screenshot (under Xvfb when there is no display).
 Run with Debian's ParaView python (scripts/install-deps --paraview):
   xvfb-run -a -s "-screen 0 1280x1024x24" pvpython tests/python/paraview_open.py --bin build/voussoir --work DIR \
       [--picture F.png] [--deck D.toml] [--set KEY=VALUE ...] [--scale S]

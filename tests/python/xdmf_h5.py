@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Reads a run's .xdmf and .h5 as a user's script would (xml.etree, h5py) and checks what
-ParaView and pandas users rely on (docs/output.md):
+ParaView and pandas users rely on (docs/reference/output.md):
   - every grid of the temporal collection has a Time value, the times increase;
   - every data item names an HDF5 dataset that resolves against the .xdmf's folder (read
     from another working directory) and has the declared dimensions;

@@ -5,7 +5,7 @@
 // the scales robust at the nine points only, whose neighbourhood holds islands of the other
 // outcome, and at the rest, where the reference itself flips within that neighbourhood.
 // Then the same at joints ten times softer (kn = 1e11 N/m3, with the impact ratio measured
-// on them), printed only. docs/rigid.md, "Rocking under records", gives the figures.
+// on them), printed only. docs/rocking.md, "Rocking under records", gives the figures.
 // Label "slow": about 90 s on one core.
 
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 // A rigid slender block under earthquake records, voussoir's `pulse` against Housner's rocking
 // equation (tests/unit/housner.hpp): the set-up shared by tests/unit/test_rocking_records.cpp
 // (the robust scales nearest each threshold) and tests/slow/test_rocking_records_slow.cpp
-// (every scale of the scan). docs/rigid.md, "Rocking under records", gives the figures.
+// (every scale of the scan). docs/rocking.md, "Rocking under records", gives the figures.
 //
 // Block: 0.25 x 1 m (the scene "block"; b/h = 0.25, alpha = 0.245 rad, p = 3.78 rad/s),
 // rho = 2000, rigid, restitution 0 (the joints' full impact damping, docs/rigid.md "Impact
@@ -189,7 +189,7 @@ inline void scan_reference(RecordStudy& st, double r, double first = kFirstScale
 // One outcome over the whole neighbourhood, sampled densely: S x (0.95, 0.955, ..., 1.05) and
 // r + (-0.01, -0.0075, ..., 0.01), 21 x 9 points. The nine points of `robust` miss what lies
 // between them: in the fall-dominated range the reference's survivals are scattered islands a
-// step of 0.5% or of 0.0025 in r wide (docs/rigid.md), and a scale robust at nine points can
+// step of 0.5% or of 0.0025 in r wide (docs/rocking.md), and a scale robust at nine points can
 // hold one in its neighbourhood.
 inline bool dense_robust(const RecordStudy& st, double scale, double r, bool fell) {
   for (int j = -4; j <= 4; ++j)

@@ -15,7 +15,7 @@
 // voussoir's joint (penalty springs with a restitution dashpot) dissipates at impact a little
 // less than Housner's plastic impact r_H = 1 - 1.5 sin^2(alpha): its ratio lies within the 5%
 // of r_H that the rigid tests allow (docs/rigid.md, Rigid.RockingBlockImpactConvergesAsTheJoint
-// Stiffens: 0.945 to 0.949 of the angular velocity kept against Housner's 0.912 on a 0.25 x 1
+// Stiffens: 0.942 to 0.948 of the angular velocity kept against Housner's 0.912 on a 0.25 x 1
 // block), so its mode-2 onset must lie in [A_2(1), A_2(r_H)].
 //
 // Checks: stepping from 1.2 g in 8% steps finds the mode-2 onset inside that interval, and its

@@ -1,7 +1,7 @@
 // A rigid slender block under earthquake records: voussoir's `pulse` against Housner's rocking
 // equation integrated beside the test, at the scales where that equation's outcome is robust
 // (set-up, records and robustness: tests/unit/rocking_records.hpp; the equation:
-// tests/unit/housner.hpp; figures: docs/rigid.md, "Rocking under records").
+// tests/unit/housner.hpp; figures: docs/rocking.md, "Rocking under records").
 //
 // For each of three records, walking the robust scales from the threshold (survivals from the
 // highest scale down, falls from the lowest up), voussoir runs at the first three survivals

@@ -1,4 +1,5 @@
-// Files and answers that users' tools take as they are (docs/output.md). Through the program:
+// Files and answers that users' tools take as they are (docs/reference/output.md). Through the
+// program:
 //   - a wall drawn in gmsh (cases/wall.geo, meshed by Debian's gmsh here): one joint per
 //     physical interface (10), the physical names in `check`, its sliding capacity = mu;
 //   - `check` refuses a model with no free block or a `fixed` index outside the blocks,
