@@ -7,6 +7,7 @@
 
 #include "commands/common.hpp"
 #include "core/schema.hpp"
+#include "engine/load_trial.hpp"
 
 namespace voussoir {
 

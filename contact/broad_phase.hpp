@@ -4,7 +4,7 @@
 // Participants. A triangle takes part when it has an edge on its block's boundary
 // (Triangles::boundary != 0): a triangle with no boundary edge is covered by its neighbours
 // and can never be the first thing another block touches. Triangles of one block never pair,
-// and two triangles of fixed blocks never pair (SPEC section 7: no contact search between
+// and two triangles of fixed blocks never pair (docs/design.md "Contact": no contact search between
 // fixed blocks). Participants are kept in ascending triangle id order; "local index" below
 // means the position in that list.
 //

@@ -32,7 +32,7 @@
 // the bound against the largest eigenvalue of finite-difference stiffness matrices (normal and
 // friction parts): it is 2.3 to 3.7 times above it (the conservative part: faces that never
 // touch anything and fixed partners count as free ones). The explicit scheme is stable for
-// dt <= 2 / omega; core/step.cpp adds this omega^2 to the element one. With the default
+// dt <= 2 / omega; engine/step.cpp adds this omega^2 to the element one. With the default
 // Ep = 100 x Lame lambda, this contact term is 80 to 130 x the element omega^2 on the shipped
 // circular arch (through_thickness 6 to 1), so it sets dt.
 
@@ -1074,7 +1074,7 @@ bool ContactSystem::joint_stiffness_mode() const {
 // each side of its outline as a face against a fixed support. With impact damping, the
 // dashpots (beta K, contact/joint_stiffness.hpp) damp that mode at the rate beta_b omega^2,
 // beta_b the largest of b's joints; the body with the shortest damped step sets it
-// (core/step.cpp stable_time_step).
+// (engine/step.cpp stable_time_step).
 std::vector<ContactFrequencyBound> ContactSystem::rigid_body_bounds(const Model& model) const {
   const Impl& s = *impl_;
   const RigidBodies& r = model.rigid;

@@ -2,7 +2,7 @@
 // Contact between blocks: NBS broad phase (contact/broad_phase), Munjiza potential-based
 // penalty force over triangle overlaps (contact/narrow_phase), Coulomb friction on accumulated
 // slip (contact/friction); for rigid blocks, the joint law between outlines
-// (contact/rigid_contact). This header is the one interface core/step.cpp calls.
+// (contact/rigid_contact). This header is the one interface engine/step.cpp calls.
 
 #include <cstdint>
 #include <memory>
@@ -38,7 +38,7 @@ struct ContactParams {
 };
 
 // Highest contact frequency bound and the damping rate (c/m) of that mode [1/s2, 1/s], for the
-// stable step of core/step.cpp.
+// stable step of engine/step.cpp.
 // The contact force of one touching pair at the current configuration, as the contact stage
 // applies it (potential, friction and impact damping parts): on_c[k] on node k (n0, n1, n2) of
 // triangle tri_c, on_t[k] on node k of triangle tri_t [N].
@@ -90,7 +90,7 @@ class ContactSystem {
   // The force of every touching pair at the current node positions and velocities, in pair
   // order: what the next add_forces would apply, evaluated on a copy of this system (detection
   // when needed, then the narrow phase and friction), so the run's state and its forces are
-  // untouched. For reports (drivers/thrust.hpp), never called inside the step.
+  // untouched. For reports (engine/thrust.hpp), never called inside the step.
   std::vector<TouchingPair> pair_forces(const Model& model, double dt) const;
   // Rigid blocks: the force of every touching block pair (contact/rigid_contact.hpp), the same
   // way (by non-smooth contact dynamics: the last step's impulses / dt); empty for elastic
@@ -122,7 +122,7 @@ class ContactSystem {
   const ContactParams& params() const;  // as given to setup
   double buffer() const;                // NBS buffer in use [m]
 
-  // Checkpoints (io/checkpoint.hpp). save_state: what evolves here -- the candidate pairs and
+  // Checkpoints (engine/checkpoint.hpp). save_state: what evolves here -- the candidate pairs and
   // their friction slip, the positions of the free participant nodes at the last detection
   // (the broad phase's reference for needs_detection), the detection and active-pair counts --
   // as opaque bytes (native byte order, like the checkpoint). restore_state, on a system set up

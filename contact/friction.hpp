@@ -1,6 +1,6 @@
 #pragma once
 // Coulomb friction on the accumulated slip of one contact pair (non-associative, elastic
-// predictor / return mapping; SPEC section 1 "Friction").
+// predictor / return mapping; docs/design.md "Contact").
 //
 // State. Each candidate pair (c, t) carries its elastic tangential displacement s [m] (a 2D
 // vector, so that it survives a rotation of the contact normal). Key: the unordered pair of

@@ -1,5 +1,5 @@
 #pragma once
-// Joint stiffness in engineering units and impact damping (SPEC section 1 and the
+// Joint stiffness in engineering units and impact damping (docs/rigid.md and the
 // `[contact]` keys normal_stiffness, shear_stiffness, restitution).
 //
 // From kn [N/m3] to a pair penalty. The potential contact force of triangles c and t is
@@ -96,7 +96,7 @@ inline constexpr double kRigidJointFactor = 100.0;
 // for stone blocks rocking and bouncing (0.3 to 0.7). Cost: the damped step is
 // kRigidDampedStepFraction (core/rigid.hpp), half the undamped one. The quasi-static phases
 // (capacity and sweep trials, their settle) damp every motion by their own technique and take
-// no dashpot unless the deck gives one (drivers/capacity.cpp settle).
+// no dashpot unless the deck gives one (engine/load_trial.cpp settle).
 inline constexpr double kRigidDefaultRestitution = 0.5;
 
 // One triangle's facing edge (reference configuration).

@@ -37,7 +37,7 @@
 // c's three edges (Sutherland-Hodgman, convex, at most 6 vertices); its area and first
 // moments are summed as a fan from its own first vertex. Every integral below is such a sum
 // over the edges of the clipped overlap or of a piece clipped from it (Green's theorem: the
-// edge-wise integration of SPEC.md). On the sub-triangle R_k(T) phi_T = 3 lambda_k has the
+// edge-wise integration of docs/design.md "Contact"). On the sub-triangle R_k(T) phi_T = 3 lambda_k has the
 // constant gradient g_k, so G_T = sum_k g_k (x) int_{P n R_k} (1, x, y) dA. With R_m the
 // sub-triangle holding P's centroid, P n R_m is P less the pieces P n R_k of the other
 // sub-triangles that P reaches into (found from the barycentric coordinates at P's vertices):

@@ -1,6 +1,6 @@
 #pragma once
-// Contact of rigid blocks: one joint law between block outlines, integrated exactly (SPEC
-// section 1, "Contact of rigid blocks").
+// Contact of rigid blocks: one joint law between block outlines, integrated exactly
+// (docs/rigid.md).
 //
 // The law. Two blocks A and B touch where their outlines overlap. On the overlap O the joint
 // carries a normal pressure kn x d (no tension), d the penetration measured along the contact

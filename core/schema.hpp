@@ -3,7 +3,7 @@
 // TOML and `--set` overrides, one row of its key table per field; everything downstream reads
 // only this struct, never the TOML. The initialisers below are the defaults of a deck that omits
 // the key (the key table prints them from a default-constructed Config).
-// The ground header of the project (core/ includes nothing from io/, drivers/ or mesh/): the
+// The ground header of the project (core/ includes nothing from another project folder): the
 // deck schema and the error types every layer may throw or catch.
 
 #include <array>
@@ -102,7 +102,7 @@ struct ContactConfig {
 struct SolverConfig {
   double dt = 0.0;                     // [s]; 0 = "auto"
   // Fraction of the stable limit used by "auto". The limit is a rigorous upper bound on the
-  // highest frequency (elements and contact, core/step.cpp), itself 1.5 to 1.9 x above the
+  // highest frequency (elements and contact, engine/step.cpp), itself 1.5 to 1.9 x above the
   // true one for contact; docs/error_vs_time.md shows lambda* unchanged from 0.25 to 0.9.
   double dt_safety = 0.9;
   double damping_factor = 1.0;         // scales eta = 2 h sqrt(E rho)
@@ -125,7 +125,7 @@ struct BaseConfig {
   std::string file;                    // accelerogram (time, acceleration)
   std::string units = "g";             // of the file's acceleration column: "g" or "m/s2"
   std::array<double, 2> band = {0.0, 0.0};  // band-pass [Hz]; {0,0} = no filter
-  // baseline correction of the file record before the band-pass (io/accelerogram.hpp):
+  // baseline correction of the file record before the band-pass (seismic/accelerogram.hpp):
   // "none", or the degree of the polynomial removed from the acceleration: "constant",
   // "linear", "quadratic"
   std::string baseline = "none";
@@ -154,7 +154,7 @@ struct CapacityConfig {
   // set to zero once the kinetic energy has fallen this fraction below its peak; in [0, 1),
   // 0 = off (docs/capacity.md "Kinetic damping")
   double kinetic_damping = 1e-3;
-  // Mass scaling of the same phases, rigid blocks (core/step.hpp equalize_rigid_inertia):
+  // Mass scaling of the same phases, rigid blocks (engine/step.hpp equalize_rigid_inertia):
   // "equalize" lowers the inertia of the blocks slower than the model's step allows, "none"
   // keeps the true inertia (docs/capacity.md "Mass scaling of the slow blocks")
   std::string mass_scaling = "equalize";

@@ -83,7 +83,7 @@ void refuse_absurd_plan(const Simulation& sim, double steps, const LoopOptions& 
 // of simulated time (steps that are multiples of the sample interval, and the last step), and
 // once at the start when starting from step 0; stops early when `sample` returns false.
 // Checks the guards above at every sample. Resumable: a simulation restored at step k
-// (io/checkpoint) continues exactly as the uninterrupted loop would, since samples and
+// (engine/checkpoint) continues exactly as the uninterrupted loop would, since samples and
 // checkpoints are placed by the absolute step number; `resume` carries the stats of the part
 // already run (max_active_pairs, wall_s), which the returned stats include.
 LoopStats run_loop(Simulation& sim, const LoopOptions& opts,

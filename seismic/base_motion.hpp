@@ -22,7 +22,7 @@
 //                  (1 cycle, even cycles): then the table ends displaced, at rest.
 //   sine_pulse     a_g(t) = A sin(2 pi f t) for 0 <= t <= 1/f (one full cycle), 0 after;
 //                  v(t) = A / (2 pi f) (1 - cos 2 pi f t): v(1/f) = 0, d(1/f) = A / (2 pi f^2).
-//   file           two columns (time [s], acceleration [g or m/s2]), read by io/accelerogram;
+//   file           two columns (time [s], acceleration [g or m/s2]), read by seismic/accelerogram;
 //                  linear interpolation between samples, zero before the first and after
 //                  the last sample.
 //

@@ -1,4 +1,4 @@
-// Base-excitation signals (core/base_motion; the accelerogram reader in io/accelerogram): the Bohman window, the windowed sine ending at
+// Base-excitation signals (seismic/base_motion; the accelerogram reader in seismic/accelerogram): the Bohman window, the windowed sine ending at
 // rest, the integration of table velocity and displacement, the zero-phase band-pass filter,
 // and the accelerogram reader.
 

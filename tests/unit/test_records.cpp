@@ -1,5 +1,5 @@
-// Earthquake records (io/accelerogram: the PEER AT2 reader, the baseline correction) and their
-// response spectra (core/spectrum: exact integration of the piecewise-linear record) against
+// Earthquake records (seismic/accelerogram: the PEER AT2 reader, the baseline correction) and their
+// response spectra (seismic/spectrum: exact integration of the piecewise-linear record) against
 // hand-written files and closed forms. The figures printed here are quoted in docs/records.md:
 //   build/test_records   (or: ctest --test-dir build -R Records -V)
 
