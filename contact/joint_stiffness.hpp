@@ -42,8 +42,8 @@
 // squarer voussoirs, and a step 2.5 times shorter, for no gain in the hinge; tall blocks on a
 // short joint (the buttresses, 3 m high on a 0.8 m base) got joints 4 times softer, and
 // lambda* of the buttressed arches 1.1 to 1.9% below the elastic blocks' (now 0.3 to 0.8%).
-// The factor: on the semicircular arch (docs/rigid.md) lambda* = 0.2792, 0.2879, 0.2923,
-// 0.2945 at kn = 1, 10, 100, 1000 x E / l (l = 0.29 m, L = 0.2 m there) against 0.2947 with
+// The factor: on the semicircular arch (docs/rigid.md) lambda* = 0.2814, 0.2890, 0.2934,
+// 0.2945 at kn = 1, 10, 100, 1000 x E / l (l = 0.29 m, L = 0.2 m there) against 0.2945 with
 // elastic blocks; 100 is the first decade within 1% of the elastic blocks. The default sets
 // the step (dt ~ 1 / sqrt(kn)): a user who knows the joints gives contact.normal_stiffness.
 //
