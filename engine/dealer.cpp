@@ -28,6 +28,7 @@
 
 #include "core/schema.hpp"
 #include "engine/solver_report.hpp"
+#include "engine/stop.hpp"
 #include "voussoir/config.hpp"
 
 #if VOUSSOIR_MPI
@@ -65,13 +66,16 @@ void deal_here(const CellWork& w, int threads) {
   std::exception_ptr failure;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
   for (long c = 0; c < n; ++c) {
-    if (is_finished(w, c)) continue;
+    // After a stop request (engine/stop.hpp) no cell starts, and a cell cut short is not taken:
+    // its record would journal the interruption as the cell's result.
+    if (is_finished(w, c) || stop_requested()) continue;
     nlohmann::json input;
     if (w.input) {
 #pragma omp critical(voussoir_deal)
       input = w.input(c);
     }
     const nlohmann::json record = w.run(c, input);
+    if (stop_requested()) continue;
 #pragma omp critical(voussoir_deal)
     try {
       w.take(c, record);
@@ -80,6 +84,7 @@ void deal_here(const CellWork& w, int threads) {
     }
   }
   if (failure) std::rethrow_exception(failure);
+  throw_if_stopped();
 }
 
 #if VOUSSOIR_MPI

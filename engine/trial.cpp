@@ -11,6 +11,7 @@
 #include "core/rigid.hpp"
 #include "engine/setup.hpp"
 #include "engine/solver_report.hpp"
+#include "engine/stop.hpp"
 
 namespace voussoir {
 
@@ -247,6 +248,7 @@ Outcome run_engine(Simulation& sim, RunSpec& spec) {
     return out;
   }
   for (;;) {
+    throw_if_stopped();
     if (spec.end_step >= 0 && sim.step >= spec.end_step) break;
     if (!(sim.ctx.time - t_start < spec.end_time)) break;
     if (spec.loads) spec.loads->apply(sim);

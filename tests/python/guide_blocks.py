@@ -8,11 +8,13 @@ A block is marked by an HTML comment on the line before its fence:
     <!-- guide-test needs=X -->    run it only when X is there: a program on PATH (gmsh,
                                    mpirun), or a python module for /usr/bin/python3 (py:pandas)
 
-followed by a ```sh fence. The blocks of one page run in order, each with `bash -e -o
-pipefail`, in one scratch folder per page that holds `cases`, `scripts`, `tests` and `docs` of
-the source tree and `build/voussoir` (the program under test), so the commands run as written
-from the repository root and write only to the scratch folder (`out/`). Pass: exit status 0
-within the timeout. Unmarked blocks (the slow ones) are shown to users but not run here.
+followed by a ```sh fence, or a ```python fence (run by /usr/bin/python3, with the Python module
+of the program's build, build/python, first on its path). The blocks of one page run in order,
+the shell's each with `bash -e -o pipefail`, in one scratch folder per page that holds `cases`,
+`scripts`, `tests` and `docs` of the source tree and `build/voussoir` (the program under test),
+so the commands run as written from the repository root and write only to the scratch folder
+(`out/`). Pass: exit status 0 within the timeout. Unmarked blocks (the slow ones) are shown to
+users but not run here.
 
     tests/python/guide_blocks.py --bin build/voussoir [--root .] [--work DIR] [--only PAGE]
 """
@@ -29,7 +31,7 @@ MARK = re.compile(r"^<!--\s*guide-test(?P<opts>[^>]*)-->\s*$")
 
 
 def blocks_of(path):
-    """(line, needs, text) of every marked ```sh block of a page."""
+    """(line, needs, language, text) of every marked ```sh or ```python block of a page."""
     lines = open(path).read().splitlines()
     out = []
     i = 0
@@ -42,12 +44,14 @@ def blocks_of(path):
         j = i + 1
         while j < len(lines) and not lines[j].strip():
             j += 1
-        if j >= len(lines) or not lines[j].startswith("```sh"):
-            raise SystemExit(f"{path}:{i + 1}: guide-test mark not followed by a ```sh block")
+        language = lines[j][3:].strip() if j < len(lines) else ""
+        if not lines[j].startswith("```") or language not in ("sh", "python"):
+            raise SystemExit(f"{path}:{i + 1}: guide-test mark not followed by a ```sh or "
+                             "```python block")
         k = j + 1
         while k < len(lines) and not lines[k].startswith("```"):
             k += 1
-        out.append((j + 1, needs, "\n".join(lines[j + 1:k]) + "\n"))
+        out.append((j + 1, needs, language, "\n".join(lines[j + 1:k]) + "\n"))
         i = k + 1
     return out
 
@@ -89,6 +93,8 @@ def main():
     env["PATH"] = "/usr/bin:/bin:" + env.get("PATH", "")   # Debian's python3 with numpy, h5py
     env["VOUSSOIR_BINARY"] = os.path.abspath(a.bin)
     env["MPLBACKEND"] = "Agg"
+    module = os.path.join(os.path.dirname(os.path.abspath(a.bin)), "python")
+    env["PYTHONPATH"] = module + os.pathsep + env.get("PYTHONPATH", "")
     failed, ran, skipped = [], 0, 0
     for page in sorted(os.listdir(guide)):
         if not page.endswith(".md") or a.only not in page:
@@ -97,7 +103,7 @@ def main():
         if not blocks:
             continue
         d = scratch(a.work, page, root, a.bin)
-        for line, needs, text in blocks:
+        for line, needs, language, text in blocks:
             where = f"docs/guide/{page}:{line}"
             lack = missing(needs)
             if lack:
@@ -106,8 +112,10 @@ def main():
                 continue
             t0 = time.time()
             try:
-                p = subprocess.run(["bash", "-e", "-o", "pipefail", "-c", text], cwd=d, env=env,
-                                   capture_output=True, text=True, timeout=a.timeout)
+                run = (["bash", "-e", "-o", "pipefail", "-c", text] if language == "sh"
+                       else ["/usr/bin/python3", "-c", text])
+                p = subprocess.run(run, cwd=d, env=env, capture_output=True, text=True,
+                                   timeout=a.timeout)
                 code, out = p.returncode, p.stdout + p.stderr
             except subprocess.TimeoutExpired as e:
                 code, out = "timeout", f"over {a.timeout:.0f} s"
