@@ -413,10 +413,8 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
 
   // CSV, written to a temporary name and renamed when complete.
   const std::string csv_path = opts.csv.empty() ? "stability.csv" : opts.csv;
-  std::ofstream csv(csv_path + ".tmp");
-  if (!csv) throw OutputError("cannot write " + csv_path);
-  csv.precision(10);
-  for (const GridAxis& a : axes) csv << a.key << ',';
+  GridCsv grid_csv(csv_path, 10, axes);
+  std::ostream& csv = grid_csv.out();
   csv << "thickness,radius,friction,stable,reason,kinetic_energy,normalised_ke,ke_time,"
          "ke_length,free_mass,max_displacement,max_rotation,decision_time,sim_time,steps,"
          "triangles,dt,wall_s,la_admissible,disagree,error\n";
@@ -424,11 +422,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   int n_stable = 0, n_disagree = 0, n_error = 0;
   for (size_t c = 0; c < cells.size(); ++c) {
     const StabilityCell& r = cells[c];
-    nlohmann::json params = nlohmann::json::object();
-    for (size_t k = 0; k < axes.size(); ++k) {
-      csv << r.values[k] << ',';
-      params[axes[k].key] = param_value(r.values[k]);
-    }
+    const nlohmann::json params = grid_csv.cell(r.values);
     csv << r.thickness << ',' << r.radius << ',' << r.friction << ',' << (r.stable ? 1 : 0) << ','
         << r.reason << ',' << r.kinetic_energy << ',' << r.normalised_kinetic_energy << ','
         << r.ke_time << ',' << r.ke_length << ',' << r.free_mass << ',' << r.max_displacement << ','
@@ -440,9 +434,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
     n_error += !r.error.empty();
     jcells.push_back(stability_cell_summary(r, params));
   }
-  csv.close();
-  if (!csv || std::rename((csv_path + ".tmp").c_str(), csv_path.c_str()) != 0)
-    throw OutputError("cannot write " + csv_path);
+  grid_csv.finish();
 
   if (keep_modes) write_collapse_modes(opts.mode_out, cells, jcells);
 
