@@ -129,7 +129,8 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   std::printf("blocks are  %s\n", info.rigid ? "rigid (one body each; no strain energy, no stress "
                                                "field)"
                                              : "elastic (constant-strain triangles)");
-  if (sim.ctx.nscd) {
+  const bool nscd = sim.scheme == StepScheme::RigidNscd;
+  if (nscd) {
     // Non-smooth contact dynamics: no stiffness, no stable limit (docs/nscd.md).
     std::printf(
         "scheme      nscd: Moreau-Jean theta = %g, rigid contact points, Gauss-Seidel to "
@@ -152,13 +153,13 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   std::sort(body_steps.begin(), body_steps.end());
   const std::size_t fastest =
       std::size_t(std::min_element(each_body.begin(), each_body.end()) - each_body.begin());
-  if (!body_steps.empty() && !sim.ctx.nscd) {
+  if (!body_steps.empty() && !nscd) {
     std::printf(
         "body steps  min %.4g s (block %zu), median %.4g s, max %.4g s: each free block "
         "alone on its joints\n",
         body_steps.front(), fastest, body_steps[body_steps.size() / 2], body_steps.back());
   }
-  if (sim.ctx.nscd) {
+  if (nscd) {
     // no joint stiffness, no penalty, no impact dashpot
   } else if (info.joint_stiffness) {
     if (config.contact.normal_stiffness > 0.0)
@@ -173,7 +174,7 @@ int command_check(const Config& config, const CommonOptions& common, const Check
   } else {
     std::printf("penalty     %.4g Pa\n", info.penalty);
   }
-  if (sim.contact.params().restitution < 1.0 && !sim.ctx.nscd)
+  if (sim.contact.params().restitution < 1.0 && !nscd)
     std::printf("restitution %.3g (impact damping%s)\n", sim.contact.params().restitution,
                 config.contact.has("restitution")
                     ? ""

@@ -15,6 +15,7 @@
 
 #include "commands/pulse.hpp"
 #include "core/fnv.hpp"
+#include "engine/bracket.hpp"
 #include "engine/dealer.hpp"
 #include "engine/run_loop.hpp"
 #include "engine/solver_report.hpp"
@@ -112,20 +113,8 @@ void validate_ida_options(const IdaOptions& opts) {
     throw DeckError("ida --period " + option_number(opts.period) +
                     " s is not allowed: the period must be a positive number of seconds");
   if (opts.period_given && opts.im != "sa") throw DeckError("ida --period applies to --im sa only");
-  if (opts.start_given && !(opts.start > 0.0 && std::isfinite(opts.start)))
-    throw DeckError("ida --start " + option_number(opts.start) +
-                    " g is not allowed: the first intensity must be a positive number of g");
-  if (!(opts.step > 0.0 && std::isfinite(opts.step)))
-    throw DeckError("ida --step " + option_number(opts.step) +
-                    " is not allowed: the relative intensity step must be positive (0.1: each "
-                    "step 10% above the last)");
-  if (opts.steps_above < 0)
-    throw DeckError("ida --steps-above " + std::to_string(opts.steps_above) +
-                    " is not allowed: the number of steps past the first collapse must be 0 or "
-                    "more");
-  if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
-    throw DeckError("ida --tolerance " + option_number(opts.tolerance) +
-                    " is not allowed: the relative bracket width must lie in (0, 1)");
+  check_stepping_options("ida", "intensity", "0.1: each step 10% above the last", opts.start_given,
+                         opts.start, opts.step, opts.steps_above, opts.tolerance);
   if (!(opts.free_time > 0.0 && std::isfinite(opts.free_time)))
     throw DeckError("ida --free-time " + option_number(opts.free_time) +
                     " s is not allowed: the free motion after the record must be a positive time");

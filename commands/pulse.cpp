@@ -586,20 +586,8 @@ void validate_pulse_options(const PulseOptions& opts) {
     throw DeckError("pulse --search \"" + opts.search +
                     "\" is not allowed: use \"step\" (raise the amplitude step by step, the "
                     "default) or \"bisect\"");
-  if (opts.start_given && !(opts.start > 0.0 && std::isfinite(opts.start)))
-    throw DeckError("pulse --start " + option_number(opts.start) +
-                    " g is not allowed: the first amplitude must be a positive number of g");
-  if (!(opts.step > 0.0 && std::isfinite(opts.step)))
-    throw DeckError("pulse --step " + option_number(opts.step) +
-                    " is not allowed: the relative amplitude step must be positive (0.05: each "
-                    "step 5% above the last)");
-  if (opts.steps_above < 0)
-    throw DeckError("pulse --steps-above " + std::to_string(opts.steps_above) +
-                    " is not allowed: the number of steps past the first collapse must be 0 or "
-                    "more");
-  if (!(opts.tolerance > 0.0 && opts.tolerance < 1.0))
-    throw DeckError("pulse --tolerance " + option_number(opts.tolerance) +
-                    " is not allowed: the relative bracket width must lie in (0, 1)");
+  check_stepping_options("pulse", "amplitude", "0.05: each step 5% above the last",
+                         opts.start_given, opts.start, opts.step, opts.steps_above, opts.tolerance);
   if (opts.tilt_reference_given &&
       !(opts.tilt_reference > 0.0 && std::isfinite(opts.tilt_reference)))
     throw DeckError("pulse --tilt-reference " + option_number(opts.tilt_reference) +

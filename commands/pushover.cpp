@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "commands/common.hpp"
+#include "engine/kinematics.hpp"
 #include "engine/motion.hpp"
 #include "engine/setup.hpp"
 #include "engine/trial.hpp"
@@ -31,38 +32,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// x of block b's centroid now [m]: the body's for a rigid block, the nodes' mass centre for an
-// elastic one (O(nodes of the block), read every step).
-double centroid_x(const Model& m, int b) {
-  if (m.is_rigid()) return m.rigid.cx0[b] + m.rigid.ux[b];
-  const Block& blk = m.blocks[b];
-  double mx = 0.0, mass = 0.0;
-  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
-    mx += m.nodes.mass[i] * m.nodes.x[i];
-    mass += m.nodes.mass[i];
-  }
-  return mx / mass;
-}
-
 // Block b's reference centroid (its outline's) [m].
 Vec2 reference_centroid(const Model& m, int b) {
   Vec2 c;
   polygon_centroid(m.blocks[std::size_t(b)].polygon, &c);
   return c;
-}
-
-// Sum over the free blocks of mass x centroid x [kg m] (true masses: the load's).
-double mass_moment_x(const Model& m) {
-  double s = 0.0;
-  if (m.is_rigid()) {
-    const RigidBodies& r = m.rigid;
-    for (std::size_t b = 0; b < m.blocks.size(); ++b)
-      if (!m.blocks[b].fixed) s += r.load_mass[b] * (r.cx0[b] + r.ux[b]);
-    return s;
-  }
-  for (Index i = 0; i < m.nodes.size(); ++i)
-    if (m.nodes.inv_mass[i] != 0.0) s += m.nodes.mass[i] * m.nodes.x[i];
-  return s;
 }
 
 }  // namespace
@@ -302,7 +276,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
 
   const int k = r.control;
   const double dir = set.direction;
-  const double x_start = centroid_x(model, k);
+  const double x_start = block_centroid_x(model, k);
   const double t_start = sim.ctx.time;
   const double servo = r.servo, rate = r.rate;
   double lambda = 0.0, target = 0.0;
@@ -310,7 +284,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   // The fast rise ramps lambda_ref on no faster than the capacity trials' ramp.
   const double fast_rate =
       std::max(rate, std::min(kFastRate * rate, r.lambda_ref / (servo * set.criteria.ramp_time)));
-  auto displacement = [&]() { return dir * (centroid_x(model, k) - x_start); };
+  auto displacement = [&]() { return dir * (block_centroid_x(model, k) - x_start); };
   set_static_load(sim, g, 0.0);
   double total_mass = 0.0;
   for (const Block& b : model.blocks)
@@ -321,7 +295,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   auto rate_energy = [](const EnergyLedger& e) {
     return e.kinetic + e.local_dissipated + e.damping_dissipated + e.impact_dissipated;
   };
-  double s_prev = dir * mass_moment_x(model);
+  double s_prev = dir * free_mass_moment_x(model);
   Window win{0.0, 0.0, s_prev, rate_energy(sim.ledger), 0.0};
   r.curve.push_back({0.0, 0.0, 0.0, 0.0, true});
 
@@ -350,7 +324,7 @@ PushoverResult run_pushover(const Config& config, const PushoverSettings& given,
   spec.quiet = quiet;
   spec.on_step = [&](Simulation& sim_now, const StepInfo&) {
     // The step just taken ran under `lambda`; its horizontal load did lambda g dS of work.
-    const double s_now = dir * mass_moment_x(sim_now.model);
+    const double s_now = dir * free_mass_moment_x(sim_now.model);
     win.work += lambda * g * (s_now - s_prev);
     win.lambda_sum += lambda;
     ++win.steps;

@@ -110,7 +110,7 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   spec.on_sample = [&](const Simulation& s, const Probe& p) {
     if (!ke_read && p.time >= ke_time) {
       c.kinetic_energy = s.ledger.kinetic;
-      c.ke_read_time = p.time;
+      c.ke_time = p.time;
       ke_read = true;
     }
     return true;
@@ -121,7 +121,7 @@ StabilityCell run_stability_cell(const Config& deck, const StabilityCriteria& cr
   c.decision_time = o.decided_at;
   c.max_displacement = o.motion.displacement;
   c.max_rotation = o.motion.rotation;
-  c.normalised_ke = ke_scale > 0.0 ? c.kinetic_energy / ke_scale : 0.0;
+  c.normalised_kinetic_energy = ke_scale > 0.0 ? c.kinetic_energy / ke_scale : 0.0;
   c.sim_time = sim.ctx.time;
   c.steps = sim.step;
   if (!c.stable) {
@@ -177,18 +177,16 @@ std::vector<std::vector<Vec2>> outlines_from_record(const nlohmann::json& j) {
   return out;
 }
 
-}  // namespace
-
-nlohmann::json stability_cell_record(const StabilityCell& r) {
-  return {{"values", r.values},
-          {"thickness", r.thickness},
-          {"radius", r.radius},
+// The fields of a cell that the journal record and the JSON summary share, under the names of
+// docs/reference/output.md ("stability").
+nlohmann::json stability_cell_fields(const StabilityCell& r) {
+  return {{"thickness", r.thickness},
           {"friction", r.friction},
           {"stable", r.stable},
           {"reason", r.reason},
           {"kinetic_energy", r.kinetic_energy},
-          {"normalised_ke", r.normalised_ke},
-          {"ke_read_time", r.ke_read_time},
+          {"normalised_kinetic_energy", r.normalised_kinetic_energy},
+          {"ke_time", r.ke_time},
           {"ke_length", r.ke_length},
           {"free_mass", r.free_mass},
           {"max_displacement", r.max_displacement},
@@ -198,13 +196,22 @@ nlohmann::json stability_cell_record(const StabilityCell& r) {
           {"steps", r.steps},
           {"wall_s", r.wall_s},
           {"triangles", r.triangles},
-          {"dt", r.dt},
-          {"l_ref", r.l_ref},
-          {"error", r.error},
-          {"hinges", hinges_record(r.hinges)},
-          {"outlines", outlines_record(r.outlines)},
-          {"outlines0", outlines_record(r.outlines0)},
-          {"fixed", r.fixed}};
+          {"dt", r.dt}};
+}
+
+}  // namespace
+
+nlohmann::json stability_cell_record(const StabilityCell& r) {
+  nlohmann::json j = stability_cell_fields(r);
+  j["values"] = r.values;
+  j["radius"] = r.radius;
+  j["l_ref"] = r.l_ref;
+  j["error"] = r.error;
+  j["hinges"] = hinges_record(r.hinges);
+  j["outlines"] = outlines_record(r.outlines);
+  j["outlines0"] = outlines_record(r.outlines0);
+  j["fixed"] = r.fixed;
+  return j;
 }
 
 StabilityCell stability_cell_from_record(const nlohmann::json& j) {
@@ -216,8 +223,8 @@ StabilityCell stability_cell_from_record(const nlohmann::json& j) {
   r.stable = j.at("stable");
   r.reason = j.at("reason");
   r.kinetic_energy = j.at("kinetic_energy");
-  r.normalised_ke = j.at("normalised_ke");
-  r.ke_read_time = j.at("ke_read_time");
+  r.normalised_kinetic_energy = j.at("normalised_kinetic_energy");
+  r.ke_time = j.at("ke_time");
   r.ke_length = j.at("ke_length");
   r.free_mass = j.at("free_mass");
   r.max_displacement = j.at("max_displacement");
@@ -307,7 +314,7 @@ std::vector<StabilityCell> run_stability_map(const Grid& grid, const StabilityCr
                      "  %-9s (%s at %.3f s) KE/MgL = %.3g at %.3f s; LA %s%s; %.1f s wall, "
                      "%.0f s elapsed\n",
                      r.stable ? "stable" : "collapsed", r.reason.c_str(), r.decision_time,
-                     r.normalised_ke, r.ke_read_time,
+                     r.normalised_kinetic_energy, r.ke_time,
                      r.la_admissible ? "admissible" : "not admissible",
                      r.disagrees() ? " (DISAGREES)" : "", r.wall_s, seconds_since(t0));
       else
@@ -326,28 +333,12 @@ namespace {
 
 // A cell of the JSON summary (docs/reference/output.md, stability).
 nlohmann::json stability_cell_summary(const StabilityCell& r, const nlohmann::json& params) {
-  nlohmann::json j = {{"params", params},
-                      {"stable", r.stable},
-                      {"reason", r.reason},
-                      {"kinetic_energy", r.kinetic_energy},
-                      {"normalised_kinetic_energy", r.normalised_ke},
-                      {"ke_time", r.ke_read_time},
-                      {"ke_length", r.ke_length},
-                      {"free_mass", r.free_mass},
-                      {"max_displacement", r.max_displacement},
-                      {"max_rotation", r.max_rotation},
-                      {"decision_time", r.decision_time},
-                      {"sim_time", r.sim_time},
-                      {"steps", r.steps},
-                      {"triangles", r.triangles},
-                      {"dt", r.dt},
-                      {"thickness", r.thickness},
-                      {"friction", r.friction},
-                      {"wall_s", r.wall_s},
-                      {"la_admissible", r.la_admissible},
-                      {"la_status", r.la_status},
-                      {"disagree", r.disagrees()},
-                      {"hinges", hinges_to_json(r.hinges)}};
+  nlohmann::json j = stability_cell_fields(r);
+  j["params"] = params;
+  j["la_admissible"] = r.la_admissible;
+  j["la_status"] = r.la_status;
+  j["disagree"] = r.disagrees();
+  j["hinges"] = hinges_to_json(r.hinges);
   if (!r.error.empty()) j["error"] = r.error;
   return j;
 }
@@ -422,10 +413,8 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
 
   // CSV, written to a temporary name and renamed when complete.
   const std::string csv_path = opts.csv.empty() ? "stability.csv" : opts.csv;
-  std::ofstream csv(csv_path + ".tmp");
-  if (!csv) throw OutputError("cannot write " + csv_path);
-  csv.precision(10);
-  for (const GridAxis& a : axes) csv << a.key << ',';
+  GridCsv grid_csv(csv_path, 10, axes);
+  std::ostream& csv = grid_csv.out();
   csv << "thickness,radius,friction,stable,reason,kinetic_energy,normalised_ke,ke_time,"
          "ke_length,free_mass,max_displacement,max_rotation,decision_time,sim_time,steps,"
          "triangles,dt,wall_s,la_admissible,disagree,error\n";
@@ -433,14 +422,10 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
   int n_stable = 0, n_disagree = 0, n_error = 0;
   for (size_t c = 0; c < cells.size(); ++c) {
     const StabilityCell& r = cells[c];
-    nlohmann::json params = nlohmann::json::object();
-    for (size_t k = 0; k < axes.size(); ++k) {
-      csv << r.values[k] << ',';
-      params[axes[k].key] = param_value(r.values[k]);
-    }
+    const nlohmann::json params = grid_csv.cell(r.values);
     csv << r.thickness << ',' << r.radius << ',' << r.friction << ',' << (r.stable ? 1 : 0) << ','
-        << r.reason << ',' << r.kinetic_energy << ',' << r.normalised_ke << ',' << r.ke_read_time
-        << ',' << r.ke_length << ',' << r.free_mass << ',' << r.max_displacement << ','
+        << r.reason << ',' << r.kinetic_energy << ',' << r.normalised_kinetic_energy << ','
+        << r.ke_time << ',' << r.ke_length << ',' << r.free_mass << ',' << r.max_displacement << ','
         << r.max_rotation << ',' << r.decision_time << ',' << r.sim_time << ',' << r.steps << ','
         << r.triangles << ',' << r.dt << ',' << r.wall_s << ',' << (r.la_admissible ? 1 : 0) << ','
         << (r.disagrees() ? 1 : 0) << ',' << csv_quote(r.error) << '\n';
@@ -449,9 +434,7 @@ int command_stability(const std::string& deck_path, const std::vector<std::strin
     n_error += !r.error.empty();
     jcells.push_back(stability_cell_summary(r, params));
   }
-  csv.close();
-  if (!csv || std::rename((csv_path + ".tmp").c_str(), csv_path.c_str()) != 0)
-    throw OutputError("cannot write " + csv_path);
+  grid_csv.finish();
 
   if (keep_modes) write_collapse_modes(opts.mode_out, cells, jcells);
 

@@ -57,16 +57,16 @@ struct StabilityCell {
   double radius = 0.0;              // model.radius of the cell [m]
   double friction = 0.0;            // contact.friction of the cell
   bool stable = false;
-  std::string reason;             // "rest", "displacement", "rotation", "timeout", "error"
-  double kinetic_energy = 0.0;    // [J per out_of_plane] at ke_read_time
-  double normalised_ke = 0.0;     // kinetic_energy / (M g L)
-  double ke_read_time = 0.0;      // [s] when the kinetic energy was read
-  double ke_length = 0.0;         // L [m]
-  double free_mass = 0.0;         // M [kg]
-  double max_displacement = 0.0;  // largest block centroid displacement at the end [m]
-  double max_rotation = 0.0;      // largest block rotation at the end [rad]
-  double decision_time = 0.0;     // [s] simulated when the classification was made
-  double sim_time = 0.0;          // [s] simulated in total
+  std::string reason;                      // "rest", "displacement", "rotation", "timeout", "error"
+  double kinetic_energy = 0.0;             // [J per out_of_plane] at ke_time
+  double normalised_kinetic_energy = 0.0;  // kinetic_energy / (M g L)
+  double ke_time = 0.0;                    // [s] when the kinetic energy was read
+  double ke_length = 0.0;                  // L [m]
+  double free_mass = 0.0;                  // M [kg]
+  double max_displacement = 0.0;           // largest block centroid displacement at the end [m]
+  double max_rotation = 0.0;               // largest block rotation at the end [rad]
+  double decision_time = 0.0;              // [s] simulated when the classification was made
+  double sim_time = 0.0;                   // [s] simulated in total
   long long steps = 0;
   double wall_s = 0.0;
   Index triangles = 0;

@@ -80,10 +80,8 @@ nlohmann::json write_sweep_csv(const std::string& csv_path, const std::vector<Gr
                                const std::vector<std::vector<std::string>>& cell_values,
                                const std::vector<CapacityResult>& results,
                                const std::vector<std::string>& errors) {
-  std::ofstream csv(csv_path + ".tmp");
-  csv.precision(17);
-  if (!csv) throw OutputError("cannot write " + csv_path);
-  for (const GridAxis& a : axes) csv << a.key << ',';
+  GridCsv grid_csv(csv_path, 17, axes);
+  std::ostream& csv = grid_csv.out();
   // One row per cell: the swept values, the result and its failure mode (hinge_joints and
   // sliding_joints: joint indices of check --mesh-out, space separated), the trials and the
   // cell's wall time. A cell taken from a --resume journal keeps its journalled wall time, so
@@ -97,11 +95,7 @@ nlohmann::json write_sweep_csv(const std::string& csv_path, const std::vector<Gr
   for (size_t c = 0; c < results.size(); ++c) {
     const CapacityResult& r = results[c];
     const bool ok = errors[c].empty();
-    nlohmann::json params = nlohmann::json::object();
-    for (size_t k = 0; k < axes.size(); ++k) {
-      csv << cell_values[c][k] << ',';
-      params[axes[k].key] = param_value(cell_values[c][k]);
-    }
+    const nlohmann::json params = grid_csv.cell(cell_values[c]);
     const std::string mode = ok ? failure_mode_text(r) : std::string();
     if (ok && r.bracketed) csv << r.lambda_star;
     csv << ',' << r.lo << ',';
@@ -120,9 +114,7 @@ nlohmann::json write_sweep_csv(const std::string& csv_path, const std::vector<Gr
                       {"wall_s", r.wall_s},
                       {"error", errors[c]}});
   }
-  csv.close();
-  if (std::rename((csv_path + ".tmp").c_str(), csv_path.c_str()) != 0)
-    throw OutputError("cannot write " + csv_path);
+  grid_csv.finish();
   return jcells;
 }
 

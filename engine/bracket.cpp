@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/schema.hpp"
+
 namespace voussoir {
 
 std::vector<double> bracket_probes(const Bracket& b, int points, ProbePlacement placement) {
@@ -57,6 +59,24 @@ std::vector<double> probes_ahead(const Bracket& b, const std::vector<double>& pr
     ahead.insert(ahead.end(), round.rbegin(), round.rend());
   }
   return ahead;
+}
+
+void check_stepping_options(const std::string& command, const std::string& quantity,
+                            const std::string& step_example, bool start_given, double start,
+                            double step, int steps_above, double tolerance) {
+  if (start_given && !(start > 0.0 && std::isfinite(start)))
+    throw DeckError(command + " --start " + option_number(start) + " g is not allowed: the first " +
+                    quantity + " must be a positive number of g");
+  if (!(step > 0.0 && std::isfinite(step)))
+    throw DeckError(command + " --step " + option_number(step) + " is not allowed: the relative " +
+                    quantity + " step must be positive (" + step_example + ")");
+  if (steps_above < 0)
+    throw DeckError(command + " --steps-above " + std::to_string(steps_above) +
+                    " is not allowed: the number of steps past the first collapse must be 0 or "
+                    "more");
+  if (!(tolerance > 0.0 && tolerance < 1.0))
+    throw DeckError(command + " --tolerance " + option_number(tolerance) +
+                    " is not allowed: the relative bracket width must lie in (0, 1)");
 }
 
 }  // namespace voussoir

@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <limits>
 #include <map>
+#include <string>
 #include <vector>
 
 namespace voussoir {
@@ -83,5 +84,13 @@ int shrink_bracket(Bracket& b, double tolerance, int points, ProbePlacement plac
   }
   return probes_run;
 }
+
+// The options of the stepping search of the classified drivers (pulse --curve, ida): --start
+// (when given) and --step positive, --steps-above 0 or more, --tolerance in (0, 1). `command`
+// and `quantity` ("amplitude", "intensity") name them in the messages, `step_example` shows a
+// --step ("0.05: each step 5% above the last"). Throws DeckError with the offending value.
+void check_stepping_options(const std::string& command, const std::string& quantity,
+                            const std::string& step_example, bool start_given, double start,
+                            double step, int steps_above, double tolerance);
 
 }  // namespace voussoir

@@ -138,7 +138,7 @@ std::uint64_t simulation_fingerprint(const Simulation& sim, double friction) {
     for (const double v : {p.normal_stiffness, p.joint_young, p.shear_stiffness, p.restitution})
       f.value(v);
   // Non-smooth contact dynamics: the scheme and its settings (explicit models hash without).
-  if (c.nscd) {
+  if (sim.scheme == StepScheme::RigidNscd) {
     f.text("nscd");
     const NscdSettings& n = c.nscd_settings;
     for (const double v : {n.theta, n.tolerance, double(n.max_iterations), n.restitution})
@@ -171,7 +171,8 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
   for (const auto* v : {&r.ux, &r.uy, &r.theta, &r.vx, &r.vy, &r.omega}) o.array(*v);
   o.value<std::uint8_t>(kContactBytes);
   o.array(sim.contact.save_state());
-  if (c.nscd) {  // the solver's record of the run so far (models of that scheme only)
+  if (sim.scheme == StepScheme::RigidNscd) {  // the solver's record of the run so far (models of
+                                              // that scheme only)
     const NscdStats& st = sim.nscd_stats;
     o.array(std::vector<double>{double(st.steps), double(st.unconverged_steps),
                                 double(st.iterations), double(st.max_iterations), st.max_residual,
@@ -237,7 +238,7 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   const auto contact_kind = in.value<std::uint8_t>();
   const std::vector<char> contact = in.array<char>();
   std::vector<double> nscd_stats;
-  if (sim.ctx.nscd) {
+  if (sim.scheme == StepScheme::RigidNscd) {
     nscd_stats = in.array<double>();
     // 7 entries; 6 from a build that had no cone solve
     if (nscd_stats.size() != 7 && nscd_stats.size() != 6)
@@ -278,7 +279,7 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     for (std::size_t b = 0; b < bodies; ++b)
       r.cx[b] = r.cx0[b] + r.ux[b], r.cy[b] = r.cy0[b] + r.uy[b];
   }
-  if (sim.ctx.nscd) {
+  if (sim.scheme == StepScheme::RigidNscd) {
     NscdStats& st = sim.nscd_stats;
     st.steps = (long long)nscd_stats[0], st.unconverged_steps = (long long)nscd_stats[1];
     st.iterations = (long long)nscd_stats[2], st.max_iterations = int(nscd_stats[3]);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "io/deck.hpp"
+#include "io/json.hpp"
 
 namespace voussoir {
 namespace {
@@ -165,6 +166,28 @@ void fingerprint_grid(Fnv& print, const std::string& deck_path,
     print.text(a.key);
     for (const std::string& v : a.values) print.text(v);
   }
+}
+
+GridCsv::GridCsv(const std::string& path, int precision, const std::vector<GridAxis>& axes)
+    : path_(path), axes_(axes), csv_(path + ".tmp") {
+  if (!csv_) throw OutputError("cannot write " + path_);
+  csv_.precision(precision);
+  for (const GridAxis& a : axes_) csv_ << a.key << ',';
+}
+
+nlohmann::json GridCsv::cell(const std::vector<std::string>& values) {
+  nlohmann::json params = nlohmann::json::object();
+  for (std::size_t k = 0; k < axes_.size(); ++k) {
+    csv_ << values[k] << ',';
+    params[axes_[k].key] = param_value(values[k]);
+  }
+  return params;
+}
+
+void GridCsv::finish() {
+  csv_.close();
+  if (!csv_ || std::rename((path_ + ".tmp").c_str(), path_.c_str()) != 0)
+    throw OutputError("cannot write " + path_);
 }
 
 }  // namespace voussoir

@@ -2,7 +2,9 @@
 // Grids of deck values for `voussoir sweep` and `voussoir stability`: the `--param` axes
 // (lists and ranges), and the grid of validated decks, row-major with the last axis fastest.
 
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,27 @@ nlohmann::json param_value(const std::string& text);
 // and the axes with their values (the journals of `sweep` and `stability`).
 void fingerprint_grid(Fnv& print, const std::string& deck_path,
                       const std::vector<std::string>& sets, const std::vector<GridAxis>& axes);
+
+// The CSV of a grid (sweep, stability): written to PATH.tmp and renamed to PATH when complete,
+// so a partial file is never taken for a finished one; each row opens with the cell's swept
+// values, the header with the axes' keys.
+class GridCsv {
+ public:
+  // Opens PATH.tmp at `precision` digits and writes the axes' keys, each followed by a comma
+  // (the caller writes the rest of the header). Throws OutputError when it cannot.
+  GridCsv(const std::string& path, int precision, const std::vector<GridAxis>& axes);
+  std::ostream& out() { return csv_; }
+  // Writes the swept values of one cell, each followed by a comma, and returns them for the
+  // JSON summary ({key: param_value}).
+  nlohmann::json cell(const std::vector<std::string>& values);
+  // Closes and renames the file; throws OutputError when it could not be written.
+  void finish();
+
+ private:
+  std::string path_;
+  const std::vector<GridAxis>& axes_;
+  std::ofstream csv_;
+};
 
 // A CSV field in double quotes (quotes inside doubled), for free text such as error messages.
 std::string csv_quote(const std::string& text);

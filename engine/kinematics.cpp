@@ -5,6 +5,30 @@
 
 namespace voussoir {
 
+double block_centroid_x(const Model& m, int b) {
+  if (m.is_rigid()) return m.rigid.cx0[b] + m.rigid.ux[b];
+  const Block& blk = m.blocks[b];
+  double mx = 0.0, mass = 0.0;
+  for (Index i = blk.first_node; i < blk.first_node + blk.node_count; ++i) {
+    mx += m.nodes.mass[i] * m.nodes.x[i];
+    mass += m.nodes.mass[i];
+  }
+  return mx / mass;
+}
+
+double free_mass_moment_x(const Model& m) {
+  double s = 0.0;
+  if (m.is_rigid()) {
+    const RigidBodies& r = m.rigid;
+    for (std::size_t b = 0; b < m.blocks.size(); ++b)
+      if (!m.blocks[b].fixed) s += r.load_mass[b] * (r.cx0[b] + r.ux[b]);
+    return s;
+  }
+  for (Index i = 0; i < m.nodes.size(); ++i)
+    if (m.nodes.inv_mass[i] != 0.0) s += m.nodes.mass[i] * m.nodes.x[i];
+  return s;
+}
+
 std::vector<BlockMotion> block_motions(const Model& model) {
   const Nodes& n = model.nodes;
   std::vector<BlockMotion> out(model.blocks.size());

@@ -21,6 +21,13 @@ struct BlockMotion {
 // (the rotation that best aligns reference to current arms in the least-squares sense).
 std::vector<BlockMotion> block_motions(const Model& model);
 
+// What an analysis reads of the blocks whatever their kind (the bodies' state for rigid
+// blocks, the nodes' for elastic ones), cheap enough for every step:
+// x of block b's centroid now [m] (elastic: the nodes' mass centre, O(nodes of the block));
+double block_centroid_x(const Model& model, int b);
+// the sum over the free blocks of mass x centroid x [kg m] (true masses: the load's).
+double free_mass_moment_x(const Model& model);
+
 // Position of the reference point p of block b moved by the block's rigid motion.
 Vec2 move_point(const BlockMotion& m, Vec2 p);
 

@@ -106,7 +106,7 @@ SettledState settle(const Config& given, const TrialCriteria& crit, bool quiet) 
 }
 
 double load_ramp(const TrialCriteria& crit, const Simulation& sim) {
-  return sim.ctx.nscd ? 0.0 : crit.ramp_time;
+  return sim.scheme == StepScheme::RigidNscd ? 0.0 : crit.ramp_time;
 }
 
 MotionExtent support_allowance(const SupportMotion& supports, double l_ref) {
@@ -419,7 +419,7 @@ std::string settled_fingerprint(const SettledState& s, const TrialCriteria& c) {
   // Non-smooth contact dynamics: its settings, which a block settled still on its ground need
   // not show (max_iterations never does when no step reaches it), as in the checkpoint's
   // fingerprint. The explicit scheme hashes without them: its journals stay valid.
-  if (s.sim.ctx.nscd) {
+  if (s.sim.scheme == StepScheme::RigidNscd) {
     f.text("nscd");
     const NscdSettings& ns = s.sim.ctx.nscd_settings;
     for (double v : {ns.theta, ns.tolerance, double(ns.max_iterations)}) f.value(v);

@@ -89,7 +89,7 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
   if (nscd) {
     // Moreau-Jean's step is not limited by any stiffness: the deck's, or kNscdDefaultStep, no
     // longer than a record's sampling interval (fit_step_to_signal).
-    sim.ctx.nscd = true;
+    sim.scheme = choose_step_scheme(sim.model, true);
     sim.ctx.nscd_settings = {config.solver.theta, config.solver.tolerance,
                              config.solver.max_iterations, cp.friction, cp.restitution};
     sim.ctx.dt = config.solver.dt > 0.0 ? config.solver.dt : kNscdDefaultStep;
@@ -152,7 +152,7 @@ Simulation make_simulation(const Config& config, SetupInfo* info) {
 }
 
 void fit_step_to_signal(Simulation& sim, const BaseSignal& signal) {
-  if (!sim.ctx.nscd || signal.kind() != BaseSignal::Kind::Table) return;
+  if (sim.scheme != StepScheme::RigidNscd || signal.kind() != BaseSignal::Kind::Table) return;
   if (!(signal.sample_dt() < sim.ctx.dt)) return;
   sim.ctx.dt = signal.sample_dt();
   sim.ctx.load_lead = sim.ctx.nscd_settings.theta * sim.ctx.dt;

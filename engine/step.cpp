@@ -56,6 +56,7 @@ void prepare_context(Simulation& sim, double damping_factor) {
   sim.ctx.eta =
       std::isfinite(h) ? damping_factor * 2.0 * h * std::sqrt(mat.young * mat.density) : 0.0;
   if (sim.model.is_rigid()) sim.ctx.eta = 0.0;  // no element stage, nothing to damp there
+  sim.scheme = choose_step_scheme(sim.model, false);
 }
 
 // Stable step = 2 / (g + sqrt(omega^2 + g^2)) (core/cst.hpp damped_stable_step) with
@@ -206,13 +207,50 @@ void advance_nscd(Simulation& sim) {
   ++sim.step;
 }
 
-}  // namespace
-
-void advance(Simulation& sim) {
-  if (sim.ctx.nscd) {
-    advance_nscd(sim);
-    return;
+// The body kinds of the explicit scheme: how forces become motion. Elastic blocks: element
+// forces on the nodes (CST + Munjiza damping at the half-step velocities), the nodes' loads and
+// central difference. Rigid blocks: no element stage; a force and a moment on each body, the
+// bodies' central difference (core/rigid.hpp).
+struct ElasticBlocks {
+  static void clear(Model& model) { clear_forces(model.nodes); }
+  static ElementStageResult element_forces(Simulation& sim, const CstLaw& law) {
+    if (law.eta > 0.0) {
+      sim.viscous_piola.resize(4 * std::size_t(sim.model.tris.size()), 0.0);  // once
+    } else {
+      sim.viscous_piola.clear();
+    }
+    return add_element_forces(sim.model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr,
+                              &sim.element_work);
   }
+  static Vec2 body_loads(Model& model, double ax, double ay) {
+    return add_body_loads(model, ax, ay);
+  }
+  static double integrate(Model& model, double dt) {
+    return integrate_central_difference(model, dt);
+  }
+  static double integrate(Model& model, double dt, LocalDamping& damping) {
+    return integrate_central_difference(model, dt, damping);
+  }
+};
+
+struct RigidBlocks {
+  static void clear(Model& model) { clear_rigid_forces(model.rigid); }
+  static ElementStageResult element_forces(Simulation& sim, const CstLaw&) {
+    sim.viscous_piola.clear();
+    return ElementStageResult{};
+  }
+  static Vec2 body_loads(Model& model, double ax, double ay) {
+    return add_rigid_body_loads(model, ax, ay);
+  }
+  static double integrate(Model& model, double dt) { return integrate_rigid_bodies(model, dt); }
+  static double integrate(Model& model, double dt, LocalDamping& damping) {
+    return integrate_rigid_bodies(model, dt, damping);
+  }
+};
+
+// The explicit step of engine/step.hpp for the blocks of kind Blocks.
+template <class Blocks>
+void advance_explicit(Simulation& sim) {
   Model& model = sim.model;
   StepContext& ctx = sim.ctx;
   EnergyLedger& ledger = sim.ledger;
@@ -222,30 +260,15 @@ void advance(Simulation& sim) {
 
   // 1. broad phase, only when some node (rigid blocks: some outline point) moved more than the
   //    buffer allows
-  const bool rigid = model.is_rigid();
   if (ctx.contact_on && sim.contact.needs_detection(model)) sim.contact.detect(model);
   clock.stamp(timers.broad);
 
   // 2. clear forces (of the nodes, or of the rigid bodies)
-  if (rigid)
-    clear_rigid_forces(model.rigid);
-  else
-    clear_forces(model.nodes);
+  Blocks::clear(model);
 
   // 3. element forces (CST + Munjiza damping at the half-step velocities); none for rigid
   //    blocks
-  const CstLaw law = law_of(ctx);
-  if (rigid) {
-    sim.viscous_piola.clear();
-  } else if (law.eta > 0.0) {
-    sim.viscous_piola.resize(4 * std::size_t(model.tris.size()), 0.0);  // once
-  } else {
-    sim.viscous_piola.clear();
-  }
-  const ElementStageResult el =
-      rigid ? ElementStageResult{}
-            : add_element_forces(model, law, law.eta > 0.0 ? sim.viscous_piola.data() : nullptr,
-                                 &sim.element_work);
+  const ElementStageResult el = Blocks::element_forces(sim, law_of(ctx));
   clock.stamp(timers.elements);
 
   // 4. contact forces (sets ledger.contact, accumulates friction dissipation)
@@ -257,8 +280,7 @@ void advance(Simulation& sim) {
   clock.stamp(timers.contact);
 
   // 5. body loads; the momentum before the update gives the exact external work
-  const Vec2 momentum = rigid ? add_rigid_body_loads(model, ctx.body_ax, ctx.body_ay)
-                              : add_body_loads(model, ctx.body_ax, ctx.body_ay);
+  const Vec2 momentum = Blocks::body_loads(model, ctx.body_ax, ctx.body_ay);
   clock.stamp(timers.loads);
 
   // 6. central difference: v then x (of the nodes, or of the rigid bodies)
@@ -266,12 +288,10 @@ void advance(Simulation& sim) {
   if (ctx.local_damping > 0.0) {
     LocalDamping damping{ctx.local_damping, ctx.local_damping_outgoing,
                          &sim.local_damping_previous};
-    kinetic = rigid ? integrate_rigid_bodies(model, ctx.dt, damping)
-                    : integrate_central_difference(model, ctx.dt, damping);
+    kinetic = Blocks::integrate(model, ctx.dt, damping);
     ledger.local_dissipated += damping.dissipated;
   } else {
-    kinetic =
-        rigid ? integrate_rigid_bodies(model, ctx.dt) : integrate_central_difference(model, ctx.dt);
+    kinetic = Blocks::integrate(model, ctx.dt);
   }
   if (ctx.kinetic_damping > 0.0) {
     KineticDamping kd{ctx.kinetic_damping, &sim.kinetic_peak};
@@ -311,6 +331,23 @@ void advance(Simulation& sim) {
   ctx.prev_body_ay = ctx.body_ay;
   ctx.time += ctx.dt;
   ++sim.step;
+}
+
+}  // namespace
+
+StepScheme choose_step_scheme(const Model& model, bool nscd) {
+  if (!model.is_rigid()) return StepScheme::ElasticExplicit;
+  return nscd ? StepScheme::RigidNscd : StepScheme::RigidExplicit;
+}
+
+void advance(Simulation& sim) {
+  using StepFunction = void (*)(Simulation&);
+  static constexpr StepFunction kSteps[] = {
+      advance_explicit<ElasticBlocks>,  // StepScheme::ElasticExplicit
+      advance_explicit<RigidBlocks>,    // StepScheme::RigidExplicit
+      advance_nscd,                     // StepScheme::RigidNscd
+  };
+  kSteps[static_cast<int>(sim.scheme)](sim);
 }
 
 }  // namespace voussoir

@@ -1,6 +1,10 @@
 #pragma once
-// One explicit step (STYLE.md "The step is one short function"): advance() calls the stages
-// in order, each stage reads the per-step context, no stage calls another, no I/O.
+// One step (STYLE.md "The step is one short function"): advance() calls the stages in order,
+// each stage reads the per-step context, no stage calls another, no I/O. The stage functions
+// come in one set per body kind and scheme (StepScheme), chosen once at set-up; advance() runs
+// the set of the simulation's scheme and asks no other question of the body kind.
+//
+// The explicit schemes (elastic blocks, rigid blocks):
 //
 //   1. broad phase if some node (rigid blocks: some outline point) moved more than the buffer
 //      allows
@@ -15,8 +19,8 @@
 //   7. prescribed supports: their work over the step, then their   core/supports
 //      pose at the step's end (only with [supports] moves)
 //
-// Rigid blocks by non-smooth contact dynamics (solver.scheme = "nscd", ctx.nscd) take the
-// other scheme, Moreau-Jean's theta-method (advance_nscd in engine/step.cpp; contact/nscd.hpp):
+// Rigid blocks by non-smooth contact dynamics (solver.scheme = "nscd", StepScheme::RigidNscd)
+// take the other scheme, Moreau-Jean's theta-method (contact/nscd.hpp):
 //   1. broad phase as above, then the contact points at the start of the step
 //   2. prescribed supports: their pose at the step's end and their velocity over it
 //   3. free velocities: v^- + h a(t + theta h) of the loads
@@ -33,6 +37,21 @@
 #include "core/supports.hpp"
 
 namespace voussoir {
+
+// The stage functions a step runs, one set per body kind and scheme: how forces become motion
+// (element forces on the nodes, or a force and a moment on each body) and how the contact
+// enters (forces of the joints, or impulses). Chosen once at set-up (choose_step_scheme),
+// never by a question inside the step.
+enum class StepScheme : unsigned char {
+  ElasticExplicit,  // elastic blocks, central difference (the nodes)
+  RigidExplicit,    // rigid blocks, central difference (the bodies)
+  RigidNscd,        // rigid blocks, Moreau-Jean's theta-method (solver.scheme = "nscd")
+};
+
+// The scheme of a model's blocks: rigid bodies (Model::is_rigid) by non-smooth contact dynamics
+// when nscd, else by the central difference; elastic blocks by the central difference (the deck
+// refuses nscd for them).
+StepScheme choose_step_scheme(const Model& model, bool nscd);
 
 // Per-step context (Box2D b2StepContext): time step, body load, law constants.
 struct StepContext {
@@ -62,10 +81,8 @@ struct StepContext {
   // set by advance(), not by drivers.
   double prev_body_ax = 0.0;
   double prev_body_ay = 0.0;
-  // Non-smooth contact dynamics of rigid blocks (solver.scheme = "nscd"): advance() takes
-  // Moreau-Jean's theta-method with the settings of contact/nscd.hpp; false: the explicit
-  // central difference.
-  bool nscd = false;
+  // Non-smooth contact dynamics of rigid blocks (StepScheme::RigidNscd): the settings of
+  // Moreau-Jean's theta-method (contact/nscd.hpp).
   NscdSettings nscd_settings;
   // The load program evaluates the loads at ctx.time + load_lead [s] (engine/trial.hpp
   // LoadProgram): theta h for nscd (the theta-method's load), 0 for the explicit scheme.
@@ -80,6 +97,9 @@ struct StageTimers {
 
 struct Simulation {
   Model model;
+  // The step's set of stage functions (prepare_context sets the explicit scheme of the
+  // model's blocks; engine/setup.cpp make_simulation then RigidNscd for solver.scheme = "nscd").
+  StepScheme scheme = StepScheme::ElasticExplicit;
   ContactSystem contact;
   EnergyLedger ledger;
   StepContext ctx;
@@ -110,7 +130,8 @@ struct Simulation {
   std::vector<double> nscd_before;
 };
 
-// Fills ctx law constants and eta from the model material and damping factor.
+// Fills ctx law constants and eta from the model material and damping factor, and chooses the
+// explicit scheme of the model's blocks (sim.scheme).
 void prepare_context(Simulation& sim, double damping_factor);
 
 // Stable time step [s] of the model (elements and, when on, contact), before the safety factor.
@@ -138,12 +159,13 @@ struct InertiaScaling {
 };
 InertiaScaling equalize_rigid_inertia(Simulation& sim);
 
-// Advances the simulation by ctx.dt. Energy ledger: strain and kinetic energy at the step
-// (core/integrate.hpp for the leapfrog K), external work and damping dissipation by the
-// trapezoid over the last position increment (exact for a linear system; engine/step.cpp).
-// Contact energy and friction come from the contact stage. At the first step (sim.step == 0) the
-// energy of the initial state (K + U + contact) is booked as external work: whoever set the initial
-// state put it in, and balance_error() stays meaningful for runs from a disturbed state.
+// Advances the simulation by ctx.dt with the stage functions of sim.scheme. Energy ledger: strain
+// and kinetic energy at the step (core/integrate.hpp for the leapfrog K), external work and damping
+// dissipation by the trapezoid over the last position increment (exact for a linear system;
+// engine/step.cpp). Contact energy and friction come from the contact stage. At the first step
+// (sim.step == 0) the energy of the initial state (K + U + contact) is booked as external work:
+// whoever set the initial state put it in, and balance_error() stays meaningful for runs from a
+// disturbed state.
 void advance(Simulation& sim);
 
 }  // namespace voussoir
