@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace voussoir {
@@ -208,5 +209,12 @@ struct SceneParams {
 inline SceneParams scene_params(const Config& c) {
   return {c.deck_path, c.deck_dir, c.model, c.mesh, c.material};
 }
+
+// The deck key of a Config field, spelled from the field's path: VOUSSOIR_KEY(model.radius) is
+// the text model.radius, and a path that is no field of Config does not compile. The key table
+// of io/deck.cpp names every key by its field's path (test DeckKeys), so the scene generators'
+// messages (mesh/) take a key's name from here rather than spell it again.
+#define VOUSSOIR_KEY(path) \
+  (static_cast<void>(sizeof(std::declval<const ::voussoir::Config&>().path)), #path)
 
 }  // namespace voussoir

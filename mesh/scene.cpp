@@ -58,7 +58,8 @@ std::string format_number(double v) {
 double element_size(const SceneParams& params, double reference) {
   if (params.mesh.size > 0.0) return params.mesh.size;
   const int n = params.mesh.through_thickness;
-  if (n < 1) geometry_error(params, "mesh.through_thickness", n, "expected an integer >= 1");
+  if (n < 1)
+    geometry_error(params, VOUSSOIR_KEY(mesh.through_thickness), n, "expected an integer >= 1");
   return reference / n;
 }
 
@@ -82,11 +83,13 @@ void choose_band_cells(double t, double length, double curvature_ratio, double h
 void check_triangle_budget(const SceneParams& params, double estimate) {
   if (estimate <= params.mesh.max_triangles) return;
   std::ostringstream why;
-  why << "would make about " << static_cast<long long>(estimate)
-      << " triangles (limit mesh.max_triangles = " << params.mesh.max_triangles
+  why << "would make about " << static_cast<long long>(estimate) << " triangles (limit "
+      << VOUSSOIR_KEY(mesh.max_triangles) << " = " << params.mesh.max_triangles
       << "); use a coarser mesh";
-  if (params.mesh.size > 0.0) geometry_error(params, "mesh.size", params.mesh.size, why.str());
-  geometry_error(params, "mesh.through_thickness", params.mesh.through_thickness, why.str());
+  if (params.mesh.size > 0.0)
+    geometry_error(params, VOUSSOIR_KEY(mesh.size), params.mesh.size, why.str());
+  geometry_error(params, VOUSSOIR_KEY(mesh.through_thickness), params.mesh.through_thickness,
+                 why.str());
 }
 
 Scene build_scene(const SceneParams& params) {
@@ -95,7 +98,8 @@ Scene build_scene(const SceneParams& params) {
   if (entry == nullptr) {
     std::string names;
     for (const std::string& n : scene_kind_names()) names += (names.empty() ? "" : ", ") + n;
-    geometry_error(params, "model.kind", "\"" + kind + "\"", "unknown scene (" + names + ")");
+    geometry_error(params, VOUSSOIR_KEY(model.kind), "\"" + kind + "\"",
+                   "unknown scene (" + names + ")");
   }
   Scene scene;
   switch (entry->builder) {
@@ -157,9 +161,9 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
         throw std::runtime_error("block " + std::to_string(i) + ": " + e.what() +
                                  ": the outline is far thinner than the element size somewhere "
                                  "(a sliver, a needle corner or a narrow slot)");
-      geometry_error(params, "mesh.max_triangles", params.mesh.max_triangles,
+      geometry_error(params, VOUSSOIR_KEY(mesh.max_triangles), params.mesh.max_triangles,
                      "block " + std::to_string(i) + ": " + e.what() +
-                         "; use a coarser mesh or raise mesh.max_triangles");
+                         "; use a coarser mesh or raise " + VOUSSOIR_KEY(mesh.max_triangles));
     } catch (const std::exception& e) {
       // The block is named in build_model's report; a deck error and a mesh that does not fit
       // in memory keep their own reports there.
@@ -185,10 +189,10 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
   std::size_t triangles = 0;
   for (const BlockSpec& b : scene.blocks) triangles += b.mesh.tris.size();
   if (static_cast<double>(triangles) > limit)
-    geometry_error(params, "mesh.max_triangles", params.mesh.max_triangles,
+    geometry_error(params, VOUSSOIR_KEY(mesh.max_triangles), params.mesh.max_triangles,
                    "the mesh has " + std::to_string(triangles) +
-                       " triangles, more than the limit; use a coarser mesh or raise "
-                       "mesh.max_triangles");
+                       " triangles, more than the limit; use a coarser mesh or raise " +
+                       VOUSSOIR_KEY(mesh.max_triangles));
 
   if (scene.check_overlaps) {
     // User-drawn blocks must not overlap: compare every pair whose boxes meet.
@@ -216,7 +220,8 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
           std::ostringstream why;
           why << "blocks " << i << " and " << j << " overlap (area " << area
               << " m2); blocks may touch but not overlap";
-          geometry_error(params, "model.file", "'" + params.model.file + "'", why.str());
+          geometry_error(params, VOUSSOIR_KEY(model.file), "'" + params.model.file + "'",
+                         why.str());
         }
       }
   }
@@ -240,7 +245,7 @@ Model mesh_scene(Scene& scene, const SceneParams& params) {
 void check_fixed_indices(const SceneParams& params, std::size_t nb, const std::string& what) {
   for (int f : params.model.fixed)
     if (f < 0 || static_cast<std::size_t>(f) >= nb)
-      geometry_error(params, "model.fixed", f,
+      geometry_error(params, VOUSSOIR_KEY(model.fixed), f,
                      "no such block: " + what + " has " + std::to_string(nb) +
                          " blocks (indices 0.." + std::to_string(nb - 1) + ")");
 }
@@ -258,7 +263,7 @@ void fix_listed_blocks(Scene& scene, const SceneParams& params) {
   std::size_t free = 0;
   for (const BlockSpec& b : scene.blocks) free += b.fixed ? 0 : 1;
   if (free == 0)
-    geometry_error(params, "model.fixed", mc.fixed.front(),
+    geometry_error(params, VOUSSOIR_KEY(model.fixed), mc.fixed.front(),
                    "every block of the model would be fixed; leave at least one free");
 }
 
@@ -279,11 +284,13 @@ Model build_model(const SceneParams& params) {
   } catch (const std::length_error&) {
     throw DeckError(where +
                     "the mesh of this model does not fit in memory: check the [model] "
-                    "dimensions against mesh.size / mesh.through_thickness");
+                    "dimensions against " +
+                    VOUSSOIR_KEY(mesh.size) + " / " + VOUSSOIR_KEY(mesh.through_thickness));
   } catch (const std::bad_alloc&) {
     throw DeckError(where +
                     "the mesh of this model does not fit in memory: check the [model] "
-                    "dimensions against mesh.size / mesh.through_thickness");
+                    "dimensions against " +
+                    VOUSSOIR_KEY(mesh.size) + " / " + VOUSSOIR_KEY(mesh.through_thickness));
   } catch (const std::exception& e) {
     throw DeckError(where + "the model cannot be meshed (" + e.what() +
                     "): check the [model] values (angles, dimensions) for degenerate blocks");

@@ -133,11 +133,13 @@ std::string fmt(double v) {
 HalfCentreline circular_centreline(const SceneParams& params) {
   const ModelConfig& mc = params.model;
   const double rc = mc.radius, t = mc.thickness, beta = mc.embrace * kDeg;
-  if (!(rc > 0.0)) geometry_error(params, "model.radius", rc, "expected a radius > 0 [m]");
+  if (!(rc > 0.0))
+    geometry_error(params, VOUSSOIR_KEY(model.radius), rc, "expected a radius > 0 [m]");
   if (!(t > 0.0 && t < 2.0 * rc))
-    geometry_error(params, "model.thickness", t,
-                   "must be below twice the centreline radius (2 x model.radius = " +
-                       fmt(2.0 * rc) + " m): the intrados radius Rc - t/2 must stay positive");
+    geometry_error(params, VOUSSOIR_KEY(model.thickness), t,
+                   "must be below twice the centreline radius (2 x " +
+                       std::string(VOUSSOIR_KEY(model.radius)) + " = " + fmt(2.0 * rc) +
+                       " m): the intrados radius Rc - t/2 must stay positive");
   HalfCentreline c;
   c.pieces.push_back(Piece{{0.0, 0.0}, rc, 0.5 * kPi, 0.5 * rc * beta});
   c.half_length = 0.5 * rc * beta;
@@ -149,21 +151,22 @@ HalfCentreline basket_centreline(const SceneParams& params) {
   const ModelConfig& mc = params.model;
   const double rc = mc.radius, d = mc.offset, r = mc.small_radius, t = mc.thickness;
   const double g = 0.5 * (180.0 - mc.embrace) * kDeg;
-  if (!(rc > 0.0)) geometry_error(params, "model.radius", rc, "expected a radius > 0 [m]");
+  if (!(rc > 0.0))
+    geometry_error(params, VOUSSOIR_KEY(model.radius), rc, "expected a radius > 0 [m]");
   if (!(r > 0.0 && r < rc))
-    geometry_error(params, "model.small_radius", r,
-                   "the small arcs must lie inside the reference circle: need 0 < r < "
-                   "model.radius = " +
-                       fmt(rc) +
+    geometry_error(params, VOUSSOIR_KEY(model.small_radius), r,
+                   "the small arcs must lie inside the reference circle: need 0 < r < " +
+                       std::string(VOUSSOIR_KEY(model.radius)) + " = " + fmt(rc) +
                        " m (their centres O3 = (Rc - r)(cos g, sin g) "
                        "must differ from O)");
   if (!(d > 0.0))
-    geometry_error(params, "model.offset", d,
+    geometry_error(params, VOUSSOIR_KEY(model.offset), d,
                    "the large arc's centre O1 = (0, -d) must lie below O (d > 0); with d <= 0 "
                    "the large arc cannot be tangent to both small arcs from above");
   if (!(t > 0.0 && t < 2.0 * r))
-    geometry_error(params, "model.thickness", t,
-                   "must be below twice model.small_radius (2 r = " + fmt(2.0 * r) +
+    geometry_error(params, VOUSSOIR_KEY(model.thickness), t,
+                   "must be below twice " + std::string(VOUSSOIR_KEY(model.small_radius)) +
+                       " (2 r = " + fmt(2.0 * r) +
                        " m): the intrados of the small arcs, radius r - t/2, must stay positive");
   const Vec2 o3{(rc - r) * std::cos(g), (rc - r) * std::sin(g)};
   const Vec2 o1{0.0, -d};
@@ -171,9 +174,10 @@ HalfCentreline basket_centreline(const SceneParams& params) {
   const double psi = std::atan2(o3.y - o1.y, o3.x - o1.x);
   // psi > g holds for d > 0 and psi < 90 deg for r < Rc; checked all the same.
   if (!(psi > g && psi < 0.5 * kPi))
-    geometry_error(params, "model.offset", d, "the small and large arcs cannot be made tangent");
+    geometry_error(params, VOUSSOIR_KEY(model.offset), d,
+                   "the small and large arcs cannot be made tangent");
   if (!(t < 2.0 * r1))
-    geometry_error(params, "model.thickness", t, "thicker than the large arc allows");
+    geometry_error(params, VOUSSOIR_KEY(model.thickness), t, "thicker than the large arc allows");
   HalfCentreline c;
   c.pieces.push_back(Piece{o1, r1, 0.5 * kPi, r1 * (0.5 * kPi - psi)});
   c.pieces.push_back(Piece{o3, r, psi, r * (psi - g)});
@@ -189,7 +193,8 @@ void add_voussoirs(const SceneParams& params, const HalfCentreline& cl, Scene& s
                    std::vector<Vec2>* left, std::vector<Vec2>* right) {
   const ModelConfig& mc = params.model;
   const int nv = mc.voussoirs;
-  if (nv < 1) geometry_error(params, "model.voussoirs", nv, "an arch needs at least 1 voussoir");
+  if (nv < 1)
+    geometry_error(params, VOUSSOIR_KEY(model.voussoirs), nv, "an arch needs at least 1 voussoir");
   const double t = mc.thickness, beta_deg = mc.embrace;
   // A voussoir much thinner along the arch than across it is a slice, not a block: its
   // meshing needs slivers or tens of thousands of cells and a time step of ~1e-10 s (found by
@@ -201,7 +206,7 @@ void add_voussoirs(const SceneParams& params, const HalfCentreline& cl, Scene& s
     why << "gives voussoirs " << voussoir_length << " m long for a thickness of " << t
         << " m (more than " << kMaxSlenderness << " times thinner than thick): use fewer "
         << "voussoirs or a larger embrace or radius";
-    geometry_error(params, "model.embrace", beta_deg, why.str());
+    geometry_error(params, VOUSSOIR_KEY(model.embrace), beta_deg, why.str());
   }
   const double h = element_size(params, t);
   int n = 1, m = 1;
@@ -290,7 +295,7 @@ void add_abutments(const SceneParams& params, Scene& scene, const std::vector<Ve
   const Vec2 down{f.y, -f.x};
   const Vec2 ib = ip + t * down, eb = ep + t * down;
   if (!(std::min(ib.x, eb.x) > 0.0))
-    geometry_error(params, "model.embrace", params.model.embrace,
+    geometry_error(params, VOUSSOIR_KEY(model.embrace), params.model.embrace,
                    "the springings are too close together for their abutments (the arch closes "
                    "on itself); use a smaller embrace");
 
@@ -329,13 +334,13 @@ void add_buttresses(const SceneParams& params, Scene& scene, const std::vector<V
   const Vec2 ip = right.front(), ep = right.back();
   const double joint_dx = ep.x - ip.x;
   if (!(bw > joint_dx * (1.0 + 1e-9)))
-    geometry_error(params, "model.buttress_width", bw,
+    geometry_error(params, VOUSSOIR_KEY(model.buttress_width), bw,
                    "the buttress must reach past the extrados springing: B must exceed the "
                    "springing joint's horizontal extent " +
                        fmt(joint_dx) + " m");
   const double y_low = std::min(ip.y, ep.y);
   if (!(-h1 < y_low - 1e-9 * mc.thickness))
-    geometry_error(params, "model.base_depth", h1,
+    geometry_error(params, VOUSSOIR_KEY(model.base_depth), h1,
                    "the ground line y = -H1 must lie below the springing (lowest springing "
                    "point at y = " +
                        fmt(y_low) + " m)");
@@ -346,7 +351,8 @@ void add_buttresses(const SceneParams& params, Scene& scene, const std::vector<V
   if (hc > 0.0) {
     const double top = y_low - 1e-9 * hc;
     if ((top - yg) / hc > 10000.0)
-      geometry_error(params, "model.courses", hc, "makes more than 10000 courses per buttress");
+      geometry_error(params, VOUSSOIR_KEY(model.courses), hc,
+                     "makes more than 10000 courses per buttress");
     for (int k = 1;; ++k) {
       const double y = yg + k * hc;
       if (!(y < top)) break;
@@ -439,11 +445,12 @@ Scene build_arch_scene(const SceneParams& params) {
   if (mc.kind == "buttressed_arch") {
     shape = mc.shape;
     if (shape != "circular" && shape != "basket")
-      geometry_error(params, "model.shape", "\"" + shape + "\"",
+      geometry_error(params, VOUSSOIR_KEY(model.shape), "\"" + shape + "\"",
                      "expected \"circular\" or \"basket\"");
   }
   if (!(mc.embrace > 0.0 && mc.embrace < 360.0))
-    geometry_error(params, "model.embrace", mc.embrace, "expected an angle in (0, 360) degrees");
+    geometry_error(params, VOUSSOIR_KEY(model.embrace), mc.embrace,
+                   "expected an angle in (0, 360) degrees");
   const HalfCentreline cl =
       shape == "circular" ? circular_centreline(params) : basket_centreline(params);
 

@@ -48,21 +48,25 @@ Scene build_block_scene(const SceneParams& params) {
   // without `height` gets a 1.0 m block.
   const double w = mc.width, ht = mc.has("height") ? mc.height : 1.0, incline = mc.incline;
   const int stack = mc.stack;
-  if (!(w > 0.0)) geometry_error(params, "model.width", w, "expected a width > 0 m");
-  if (!(ht > 0.0)) geometry_error(params, "model.height", ht, "expected a height > 0 m");
-  if (stack < 1) geometry_error(params, "model.stack", stack, "expected at least 1 block");
+  if (!(w > 0.0)) geometry_error(params, VOUSSOIR_KEY(model.width), w, "expected a width > 0 m");
+  if (!(ht > 0.0))
+    geometry_error(params, VOUSSOIR_KEY(model.height), ht, "expected a height > 0 m");
+  if (stack < 1)
+    geometry_error(params, VOUSSOIR_KEY(model.stack), stack, "expected at least 1 block");
   if (!(incline >= 0.0 && incline < 90.0))
-    geometry_error(params, "model.incline", incline, "expected an angle in [0, 90) degrees");
+    geometry_error(params, VOUSSOIR_KEY(model.incline), incline,
+                   "expected an angle in [0, 90) degrees");
   if (stack * ht > kMaxStackToWidth * w) {
     std::ostringstream why;
-    why << "a stack of " << stack << " block(s) " << ht << " m tall (model.stack x model.height) "
-        << "on a base " << w << " m wide (model.width) is " << stack * ht / w
+    why << "a stack of " << stack << " block(s) " << ht << " m tall (" << VOUSSOIR_KEY(model.stack)
+        << " x " << VOUSSOIR_KEY(model.height) << ") on a base " << w << " m wide ("
+        << VOUSSOIR_KEY(model.width) << ") is " << stack * ht / w
         << " times taller than wide (at most " << kMaxStackToWidth
         << "): the ground the scene lays under it would reach " << 1.5 * w + stack * ht
         << " m to each side and be " << 0.5 * w
         << " m deep, a strip whose mesh takes seconds to hours; use a wider base, lower blocks "
            "or fewer";
-    geometry_error(params, "model.height", ht, why.str());
+    geometry_error(params, VOUSSOIR_KEY(model.height), ht, why.str());
   }
 
   const double h = element_size(params, std::min(w, ht));

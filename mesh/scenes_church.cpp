@@ -127,27 +127,31 @@ void check_church(const SceneParams& params, double t) {
   const double pier = mc.pier_width, outer = mc.outer_width, height = mc.height;
   const double ecc = mc.eccentricity, dtheta = mc.voussoir_angle * kDeg;
   const double hc = mc.courses;
-  if (ns < 1) geometry_error(params, "model.spans", "[]", "expected at least one span");
+  if (ns < 1) geometry_error(params, VOUSSOIR_KEY(model.spans), "[]", "expected at least one span");
   for (double s : spans)
-    if (!(s > 0.0)) geometry_error(params, "model.spans", s, "every span must be > 0 m");
-  if (!(t > 0.0)) geometry_error(params, "model.thickness", t, "expected a thickness > 0 m");
+    if (!(s > 0.0))
+      geometry_error(params, VOUSSOIR_KEY(model.spans), s, "every span must be > 0 m");
+  if (!(t > 0.0))
+    geometry_error(params, VOUSSOIR_KEY(model.thickness), t, "expected a thickness > 0 m");
   // A support exactly as wide as its springings (pier = 2t, outer = t, the default church)
   // is allowed: the extrados springing points then meet at the pier's middle (or the outer
   // face) and are made the same point.
   if (!(outer >= t * (1.0 - kTight)))
-    geometry_error(params, "model.outer_width", outer,
-                   "an outer buttress must carry its arch's springing joint: it must be at least "
-                   "model.thickness = " +
-                       fmt(t) + " m wide");
+    geometry_error(params, VOUSSOIR_KEY(model.outer_width), outer,
+                   "an outer buttress must carry its arch's springing joint: it must be at least " +
+                       std::string(VOUSSOIR_KEY(model.thickness)) + " = " + fmt(t) + " m wide");
   if (ns > 1 && !(pier >= 2.0 * t * (1.0 - kTight)))
-    geometry_error(params, "model.pier_width", pier,
-                   "too narrow for its two springings: a pier carries two springing joints of "
-                   "model.thickness = " +
-                       fmt(t) + " m each, so it must be at least " + fmt(2.0 * t) + " m wide");
-  if (!(height > 0.0)) geometry_error(params, "model.height", height, "expected a height > 0 m");
-  if (!(ecc >= 0.0)) geometry_error(params, "model.eccentricity", ecc, "expected a value >= 0");
+    geometry_error(params, VOUSSOIR_KEY(model.pier_width), pier,
+                   "too narrow for its two springings: a pier carries two springing joints of " +
+                       std::string(VOUSSOIR_KEY(model.thickness)) + " = " + fmt(t) +
+                       " m each, so it must be at least " + fmt(2.0 * t) + " m wide");
+  if (!(height > 0.0))
+    geometry_error(params, VOUSSOIR_KEY(model.height), height, "expected a height > 0 m");
+  if (!(ecc >= 0.0))
+    geometry_error(params, VOUSSOIR_KEY(model.eccentricity), ecc, "expected a value >= 0");
   if (!(dtheta > 0.0 && dtheta < 0.5 * kPi))
-    geometry_error(params, "model.voussoir_angle", mc.voussoir_angle, "expected (0, 90) degrees");
+    geometry_error(params, VOUSSOIR_KEY(model.voussoir_angle), mc.voussoir_angle,
+                   "expected (0, 90) degrees");
   // Absurd sizes. Supports are outlined at the arches' element size before any triangle
   // budget can be estimated (mesh/scene.cpp), so a 4.3e9 m outer buttress (a fuzzing finding)
   // exhausted memory in the generator. No church has a support or a height of more than
@@ -160,16 +164,17 @@ void check_church(const SceneParams& params, double t) {
                      "expected at most " + fmt(kMaxSizeToSpan) + " x the largest span (" +
                          fmt(span_max) + " m), i.e. " + fmt(size_limit) + " m");
   };
-  refuse_above_limit("model.outer_width", outer);
-  if (ns > 1) refuse_above_limit("model.pier_width", pier);
-  refuse_above_limit("model.height", height);
+  refuse_above_limit(VOUSSOIR_KEY(model.outer_width), outer);
+  if (ns > 1) refuse_above_limit(VOUSSOIR_KEY(model.pier_width), pier);
+  refuse_above_limit(VOUSSOIR_KEY(model.height), height);
   if (!(height >= kMinHeightToSpan * span_max))
-    geometry_error(params, "model.height", height,
+    geometry_error(params, VOUSSOIR_KEY(model.height), height,
                    "expected at least " + fmt(kMinHeightToSpan) + " x the largest span (" +
                        fmt(span_max) + " m), i.e. " + fmt(kMinHeightToSpan * span_max) + " m");
-  refuse_above_limit("model.thickness", t);
+  refuse_above_limit(VOUSSOIR_KEY(model.thickness), t);
   if (hc > 0.0 && height / hc > 10000.0)
-    geometry_error(params, "model.courses", hc, "makes more than 10000 courses per support");
+    geometry_error(params, VOUSSOIR_KEY(model.courses), hc,
+                   "makes more than 10000 courses per support");
 }
 
 // Support faces, left to right; mirrored exactly when the church is symmetric.
@@ -218,7 +223,7 @@ ArchBlocks church_arch(const SceneParams& params, double t, double h,
   if (th_i - kh * dtheta < 0.5 * dtheta) --kh;
   kh = std::max(kh, 0);
   if (kh > 100000)
-    geometry_error(params, "model.voussoir_angle", mc.voussoir_angle,
+    geometry_error(params, VOUSSOIR_KEY(model.voussoir_angle), mc.voussoir_angle,
                    "makes more than 100000 voussoirs per half arch");
   int n = 1, m = 1;
   choose_band_cells(t, (ri + 0.5 * t) * dtheta, 0.5 * t / (ri + 0.5 * t), h, &n, &m);

@@ -182,7 +182,7 @@ struct GmshBlocks {
 // The sections of an MSH 4.1 ASCII file that make blocks: the physical tags and names of the
 // surfaces, the nodes, the triangles of each surface.
 struct GmshSections {
-  std::map<int, int> surface_physical;  // surface tag -> first physical tag (absent: none)
+  std::map<int, int> surface_physical;        // surface tag -> first physical tag (absent: none)
   std::map<int, std::string> physical_names;  // physical surface tag -> its name
   std::map<std::size_t, std::array<double, 3>> nodes;
   std::map<int, std::vector<std::array<std::size_t, 3>>> surface_tris;
@@ -398,8 +398,9 @@ Scene build_polygons_scene(const SceneParams& params) {
   const ModelConfig& mc = params.model;
   namespace fs = std::filesystem;
   if (mc.file.empty())
-    geometry_error(params, "model.file", "\"\"",
-                   "model.kind = \"polygons\" needs a file of blocks");
+    geometry_error(
+        params, VOUSSOIR_KEY(model.file), "\"\"",
+        std::string(VOUSSOIR_KEY(model.kind)) + " = \"polygons\" needs a file of blocks");
   fs::path path(mc.file);
   if (path.is_relative() && !fs::exists(path) && !params.deck_dir.empty())
     path = fs::path(params.deck_dir) / path;
@@ -440,7 +441,7 @@ Scene build_polygons_scene(const SceneParams& params) {
       }
     }
   } catch (const FileError& e) {
-    geometry_error(params, "model.file", shown, e.what);
+    geometry_error(params, VOUSSOIR_KEY(model.file), shown, e.what);
   }
 
   const std::size_t nb = scene.blocks.size();
@@ -457,9 +458,9 @@ Scene build_polygons_scene(const SceneParams& params) {
     std::string list = "[";
     for (std::size_t k = 0; k < mc.fixed.size(); ++k)
       list += (k ? ", " : "") + std::to_string(mc.fixed[k]);
-    geometry_error(params, "model.fixed", list + "]",
+    geometry_error(params, VOUSSOIR_KEY(model.fixed), list + "]",
                    "every block of the file is fixed (it has " + std::to_string(nb) +
-                       "); leave at least one block out of model.fixed");
+                       "); leave at least one block out of " + VOUSSOIR_KEY(model.fixed));
   }
 
   // Element size from the smallest free block (all blocks if none is free).
