@@ -29,6 +29,12 @@ constexpr int kConeProducts = 3000;
 constexpr int kTrescaPasses = 16;
 constexpr int kNewtonEvery = 10;
 constexpr double kFaceRegularisation = 1e-6;
+// Active-set steps at the start of each box (box_qp) before MPRGP takes over: from the sweeps'
+// impulses one or two usually solve the box, and a pass of Tresca's box that keeps the face
+// reuses its factors. A step is kept even when it raises f (the best iterate is returned to
+// MPRGP): refusing such steps, as MPRGP's own Newton steps do, sent a quarter of the boxes to
+// MPRGP and took 2.4 times the products on church_b under a record.
+constexpr int kActiveSetSteps = 8;
 // Power iterations for the largest eigenvalue of W (the projections' step), and its margin
 // (power iterations approach it from below).
 constexpr int kPowerIterations = 8;
@@ -268,6 +274,12 @@ inline void local_velocity(const ContactPoint& c, const double* v, double rax, d
 // back when the chopped gradient outweighs the free one. Every kNewtonEvery products,
 // face_newton(free, g, d) offers d = -A_FF^-1 g_F on the free face F; its projection on the
 // box is taken when it lowers f (else a quarter of it, up to three times).
+// Before MPRGP, up to kActiveSetSteps primal-dual active-set steps (Hintermueller, Ito and
+// Kunisch, SIAM J. Optim. 13 (2002)): a component that y - g puts past a bound is held at it,
+// the others are free, and the Newton step on the free face follows, projected on the box.
+// Keeping the status of a component at a bound whose gradient is within the tolerance (so that
+// the face and its factors carry over) saved 15% of the factorisations on church_b but left a
+// step of the 90-voussoir chain at the cap (test Nscd.AChainOfNinetyVoussoirs...).
 // Stops when every component of the projected gradient times `weight` is at most `tol`
 // (`converged`), or after `max_products` products with A. Returns the products used.
 template <class Apply, class FaceNewton, class StepLength>
@@ -317,8 +329,37 @@ int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vecto
   for (std::size_t i = 0; i < m; ++i) y[i] = std::clamp(y[i], lo[i], hi[i]);
   gradient_at(y, g);
   double worst = split();
-  p = phi;
   converged = false;
+  std::vector<double> y_best, g_best;  // the lowest f of the active-set steps, when one rose
+  double f_best = 0.0;
+  for (int step = 0; step < kActiveSetSteps && worst > tol && products < max_products; ++step) {
+    bool moved = false;
+    for (std::size_t i = 0; i < m; ++i) {
+      const double t = y[i] - g[i];
+      const bool is_free = lo[i] < t && t < hi[i];
+      y_try[i] = is_free ? y[i] : t <= lo[i] ? lo[i] : t >= hi[i] ? hi[i] : y[i];
+      free[i] = is_free;
+      moved = moved || y_try[i] != y[i];
+    }
+    if (moved)
+      gradient_at(y_try, g_try);
+    else
+      g_try = g;
+    if (!face_newton(free, g_try, d)) break;
+    for (std::size_t i = 0; i < m; ++i) y_try[i] = std::clamp(y_try[i] + d[i], lo[i], hi[i]);
+    gradient_at(y_try, g_try);
+    const double f_try = objective(y_try, g_try), f = objective(y, g);
+    if (f_try > f && y_best.empty()) y_best = y, g_best = g, f_best = f;
+    y.swap(y_try), g.swap(g_try);
+    worst = split();
+    if (!y_best.empty() && f_try < f_best) y_best = y, g_best = g, f_best = f_try;
+  }
+  if (!y_best.empty() && worst > tol && objective(y, g) > f_best) {
+    y.swap(y_best), g.swap(g_best);
+    worst = split();
+  }
+  last_newton = products;
+  p = phi;
   while (products < max_products) {
     if (worst <= tol) {
       converged = true;

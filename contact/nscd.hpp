@@ -55,8 +55,11 @@
 // over the box r_n >= 0, |r_t| <= mu r_n (f's gradient W r + q - u = U - u: its KKT conditions
 // are Signorini's with Newton's u_min and Tresca's law). The box is solved by MPRGP (conjugate
 // gradients on the free face with projections: their products grow like N along a chain where
-// the sweeps grow like N^2), in variables scaled by the Delassus diagonal, with a Newton step
-// on the free face (a sparse LDL^T of W_FF) every few products, kept when it lowers f. Then
+// the sweeps grow like N^2), in variables scaled by the Delassus diagonal, after a few
+// active-set steps (an impulse that a step down f's gradient takes past its bound is held at
+// it, a Newton step on the rest: a sparse LDL^T of W_FF), which from the sweeps' impulses
+// usually solve the box alone, and with a Newton step on the free face every few products,
+// kept when it lowers f. Then
 // mu r_n gives the next box, for at most kTrescaPasses boxes. The products apply W as
 // H M^-1 H^T; the Newton steps factor the free face of W, assembled once per cone solve. Two
 // points on every joint make the contacts redundant (W singular): with restitution 0 the gaps'
