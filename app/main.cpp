@@ -3,8 +3,6 @@
 // status (docs/reference/commands.md): 0 success, 2 bad deck or arguments, 1 failure during a
 // run.
 
-#include <omp.h>
-
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -54,9 +52,7 @@ int main(int argc, char** argv) {
       // rank 0 alone.
       const bool dealt = action.dealt && action.dealt();
       if (!dealt && !speaks) return 0;
-      voussoir::make_output_folders(*cmd);
-      if (line.common.threads > 0) omp_set_num_threads(line.common.threads);
-      return action.run();
+      return voussoir::run_parsed_command(*cmd, line, action);
     }
   } catch (const voussoir::DeckError& e) {
     if (speaks) std::fprintf(stderr, "voussoir: error: %s\n", e.what());

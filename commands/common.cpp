@@ -3,12 +3,15 @@
 
 #include "commands/common.hpp"
 
+#include <omp.h>
+
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <set>
 #include <string>
 #include <system_error>
 
+#include "engine/solver_report.hpp"
 #include "io/deck.hpp"
 
 namespace voussoir {
@@ -49,6 +52,13 @@ void make_output_folders(const CLI::App& cmd) {
                         (ec ? ": " + ec.message() : ""));
     }
   }
+}
+
+int run_parsed_command(const CLI::App& cmd, const CommandLine& line, const CommandAction& action) {
+  make_output_folders(cmd);
+  if (line.common.threads > 0) omp_set_num_threads(line.common.threads);
+  reset_solver_record();
+  return action.run();
 }
 
 }  // namespace voussoir

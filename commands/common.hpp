@@ -106,6 +106,12 @@ struct Command {
   CommandAction (*add)(CLI::App& cmd, CommandLine& line);
 };
 
+// Runs a parsed command (`cmd` its CLI11 subcommand, `line` and `action` what its `add`
+// filled): makes the folders of its output files, sets the OpenMP threads of --threads, starts
+// the solver's record afresh (the JSON's "solver" is this command's) and returns the action's
+// exit status. The program (app/main.cpp) and the Python module (python/module.cpp) alike.
+int run_parsed_command(const CLI::App& cmd, const CommandLine& line, const CommandAction& action);
+
 // Every subcommand, in the order of `voussoir --help` (commands/table.cpp).
 const std::vector<Command>& command_table();
 

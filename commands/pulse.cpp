@@ -618,18 +618,8 @@ nlohmann::json control_json(const std::vector<ControlSummary>& control) {
 }
 
 SeriesRecord series_record(const Simulation& sim, const PulseSample& s) {
-  const EnergyLedger& l = sim.ledger;
-  SeriesRecord r;
+  SeriesRecord r = series_record(sim);
   r.time = s.time;
-  r.kinetic = l.kinetic;
-  r.strain = l.strain;
-  r.contact = l.contact;
-  r.damping_dissipated = l.damping_dissipated + l.impact_dissipated;  // io/hdf5_output.hpp
-  r.friction_dissipated = l.friction_dissipated;
-  r.external_work = l.external_work;
-  r.max_displacement = max_free_displacement(sim.model);
-  r.active_contacts = sim.contact.active_pairs();
-  r.energy_balance_error = l.balance_error();
   r.control_displacements = {s.table_acceleration, s.table_velocity, s.table_displacement};
   for (size_t p = 0; p < s.control_ux.size(); ++p) {
     r.control_displacements.push_back(s.control_ux[p]);

@@ -36,22 +36,6 @@
 namespace voussoir {
 namespace {
 
-SeriesRecord series_record(const Simulation& sim) {
-  const EnergyLedger& l = sim.ledger;
-  SeriesRecord r;
-  r.time = sim.ctx.time;
-  r.kinetic = l.kinetic;
-  r.strain = l.strain;
-  r.contact = l.contact;
-  r.damping_dissipated = l.damping_dissipated + l.impact_dissipated;  // io/hdf5_output.hpp
-  r.friction_dissipated = l.friction_dissipated;
-  r.external_work = l.external_work;
-  r.max_displacement = max_free_displacement(sim.model);
-  r.active_contacts = sim.contact.active_pairs();
-  r.energy_balance_error = l.balance_error();
-  return r;
-}
-
 // Driver values of a checkpoint (engine/checkpoint.hpp keeps them opaque): a format tag, the
 // scalars below, then the series rows, kRowValues doubles each.
 constexpr double kDriverFormat = 1.0;

@@ -22,6 +22,22 @@ double max_free_displacement(const Model& model) {
   return std::sqrt(d2);
 }
 
+SeriesRecord series_record(const Simulation& sim) {
+  const EnergyLedger& l = sim.ledger;
+  SeriesRecord r;
+  r.time = sim.ctx.time;
+  r.kinetic = l.kinetic;
+  r.strain = l.strain;
+  r.contact = l.contact;
+  r.damping_dissipated = l.damping_dissipated + l.impact_dissipated;  // io/hdf5_output.hpp
+  r.friction_dissipated = l.friction_dissipated;
+  r.external_work = l.external_work;
+  r.max_displacement = max_free_displacement(sim.model);
+  r.active_contacts = sim.contact.active_pairs();
+  r.energy_balance_error = l.balance_error();
+  return r;
+}
+
 void refuse_absurd_plan(const Simulation& sim, double steps, const LoopOptions& opts) {
   if (opts.limits.max_steps > 0 || !(steps > kMaxPlannedSteps)) return;
   // The wall they imply: kProbeSteps steps of a copy, timed.

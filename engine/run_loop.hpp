@@ -34,6 +34,7 @@
 
 #include "engine/step.hpp"
 #include "engine/trial.hpp"
+#include "io/hdf5_output.hpp"
 
 namespace voussoir {
 
@@ -42,6 +43,11 @@ namespace voussoir {
 
 // Largest displacement magnitude of any free node from its reference position [m].
 double max_free_displacement(const Model& model);
+
+// One row of the HDF5 time series (io/hdf5_output.hpp) from the simulation as it is: the
+// ledger's terms (damping and impact dissipation together), the largest displacement, the
+// active contacts, the balance error; no control points (`pulse` adds its own).
+SeriesRecord series_record(const Simulation& sim);
 
 // The most steps a run plans (solver.end_time / dt) without --max-steps: a masonry run takes
 // 1e4 to 1e7 (dt of 1e-6 to 1e-5 s over seconds); 1e8 steps is minutes to hours of wall, and

@@ -4,7 +4,6 @@
 // lists the table's commands and options, from which the package makes one function per
 // command; and it carries the stop request of Ctrl-C (engine/stop.hpp).
 
-#include <omp.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -15,7 +14,6 @@
 #include <vector>
 
 #include "commands/common.hpp"
-#include "engine/solver_report.hpp"
 #include "engine/stop.hpp"
 #include "io/deck.hpp"
 #include "voussoir/config.hpp"
@@ -47,10 +45,7 @@ int parse_and_run(const std::vector<std::string>& args) {
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());
   app.parse(static_cast<int>(argv.size()), argv.data());
-  make_output_folders(*cmd);
-  if (line.common.threads > 0) omp_set_num_threads(line.common.threads);
-  reset_solver_record();  // the solver's record is the command's, not the process's so far
-  return action.run();
+  return run_parsed_command(*cmd, line, action);
 }
 
 // The table's commands and options, for the package's functions and the reference page.
