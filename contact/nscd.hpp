@@ -59,14 +59,13 @@
 // active-set steps (an impulse that a step down f's gradient takes past its bound is held at
 // it, a Newton step on the rest: a sparse LDL^T of W_FF), which from the sweeps' impulses
 // usually solve the box alone, and with a Newton step on the free face every few products,
-// kept when it lowers f. Then
-// mu r_n gives the next box, for at most kTrescaPasses boxes. The products apply W as
-// H M^-1 H^T; the Newton steps factor the free face of W, assembled once per cone solve. Two
-// points on every joint make the contacts redundant (W singular): with restitution 0 the gaps'
-// u_min <= 0 keep f bounded below (with a restitution, the cap on the products bounds the
-// solve), and the face's matrix takes a small regularisation. The solution is where the sweeps go
-// on from; they decide convergence, on the same tolerance, and take the cone solve again after
-// every kSweepsBeforeCone sweeps.
+// kept when it lowers f. Then mu r_n gives the next box, for at most kTrescaPasses boxes. The
+// products apply W as H M^-1 H^T; the Newton steps factor the free face of W, assembled once
+// per cone solve. Two points on every joint make the contacts redundant (W singular): with
+// restitution 0 the gaps' u_min <= 0 keep f bounded below (with a restitution, the cap on the
+// products bounds the solve), and the face's matrix takes a small regularisation. The solution
+// is where the sweeps go on from; they decide convergence, on the same tolerance, and take the
+// cone solve again after every kSweepsBeforeCone sweeps.
 //
 // Energy (the ledger's terms, booked from the impulses, never as a remainder). Over a step the
 // bodies' kinetic energy changes by (h F + P) . (v^- + v^+) / 2 (P: the contact impulses on the
