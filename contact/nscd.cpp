@@ -166,6 +166,8 @@ void NscdStats::add(const NscdStepResult& r) {
   ++steps;
   iterations += r.iterations;
   if (r.cone_products > 0) ++cone_steps;
+  cone_products += r.cone_products;
+  factorisations += r.factorisations;
   if (!r.converged) ++unconverged_steps;
   max_iterations = std::max(max_iterations, r.iterations);
   max_residual = std::max(max_residual, r.residual);
@@ -435,6 +437,9 @@ int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vecto
   return products;
 }
 
+// The factorisations of a face's matrix on this thread so far (FaceScratch below).
+long long thread_factorisations();
+
 }  // namespace
 
 NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& before, double h,
@@ -506,7 +511,9 @@ NscdStepResult NscdContact::solve(Model& model, const std::vector<double>& befor
     // solve puts them in place (cone_solve); the sweeps go on from there and judge it, and
     // take it again after as many sweeps.
     if (out.iterations % kSweepsBeforeCone == 0) {
+      const long long factored = thread_factorisations();
       out.cone_products += cone_solve(inv, v_free, u_min, mu, settings.tolerance * v_scale);
+      out.factorisations += int(thread_factorisations() - factored);
       v = v_free;
       for (std::size_t k = 0; k < n; ++k)
         if (rn_[k] != 0.0 || rt_[k] != 0.0) apply(k, rn_[k], rt_[k]);
@@ -659,11 +666,16 @@ struct FaceScratch {
   Eigen::SimplicialLDLT<FaceMatrix, Eigen::Upper, Eigen::NaturalOrdering<Eigen::Index>> ldlt;
   Eigen::VectorXd rhs, x;
   bool analysed = false;
+  long long factorisations = 0;  // on this thread, for the solver's record
   // The face whose factors ldlt holds (empty: none). A face met again in the same cone solve
   // (a later pass of Tresca's box keeps the face more often than not) reuses them.
   std::vector<char> factored_face;
 };
 thread_local FaceScratch t_face;
+
+long long thread_factorisations() {
+  return t_face.factorisations;
+}
 
 // The entries of the bodies (unknowns in order, grouped by body; fixed bodies have none).
 template <class Entry>
@@ -789,6 +801,7 @@ bool factor_face(Eigen::Index m, const OnFace& on_face) {
     w.analysed = true;
   }
   w.ldlt.factorize(w.a);
+  ++w.factorisations;
   if (w.ldlt.info() != Eigen::Success) return false;
   w.factored_face.resize(std::size_t(m));
   for (Eigen::Index i = 0; i < m; ++i) w.factored_face[std::size_t(i)] = char(on_face(i));

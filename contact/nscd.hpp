@@ -126,7 +126,8 @@ struct NscdSettings {
 // What one step's solve gives.
 struct NscdStepResult {
   int iterations = 0;
-  int cone_products = 0;  // products with W of the step's cone solves (0: none)
+  int cone_products = 0;   // products with W of the step's cone solves (0: none)
+  int factorisations = 0;  // factorisations of a face's matrix in them
   bool converged = true;
   double residual = 0.0;     // the last sweep's relative change of the impulses
   double penetration = 0.0;  // largest overlap -g of a point at the start of the step [m]
@@ -144,6 +145,8 @@ struct NscdStats {
   long long unconverged_steps = 0;  // steps that stopped at max_iterations
   long long iterations = 0;         // summed over the steps
   long long cone_steps = 0;         // steps that took the cone solve
+  long long cone_products = 0;      // products with W in the cone solves, summed
+  long long factorisations = 0;     // factorisations of a face's matrix, summed
   int max_iterations = 0;           // largest iteration count of a step
   double max_residual = 0.0;        // largest final residual of a step
   double max_penetration = 0.0;     // largest overlap of a contact point seen [m]

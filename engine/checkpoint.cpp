@@ -176,7 +176,8 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
     const NscdStats& st = sim.nscd_stats;
     o.array(std::vector<double>{double(st.steps), double(st.unconverged_steps),
                                 double(st.iterations), double(st.max_iterations), st.max_residual,
-                                st.max_penetration, double(st.cone_steps)});
+                                st.max_penetration, double(st.cone_steps), double(st.cone_products),
+                                double(st.factorisations)});
   }
   o.array(driver_state);
   Fnv sum;
@@ -240,8 +241,9 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
   std::vector<double> nscd_stats;
   if (sim.scheme == StepScheme::RigidNscd) {
     nscd_stats = in.array<double>();
-    // 7 entries; 6 from a build that had no cone solve
-    if (nscd_stats.size() != 7 && nscd_stats.size() != 6)
+    // 9 entries; 7 from a build that did not count the cone solve's work, 6 from one that had
+    // no cone solve
+    if (nscd_stats.size() != 9 && nscd_stats.size() != 7 && nscd_stats.size() != 6)
       in.fail("the non-smooth contact solver's record is not readable");
   }
   std::vector<double> driver = in.array<double>();
@@ -285,6 +287,8 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     st.iterations = (long long)nscd_stats[2], st.max_iterations = int(nscd_stats[3]);
     st.max_residual = nscd_stats[4], st.max_penetration = nscd_stats[5];
     st.cone_steps = nscd_stats.size() > 6 ? (long long)nscd_stats[6] : 0;
+    st.cone_products = nscd_stats.size() > 7 ? (long long)nscd_stats[7] : 0;
+    st.factorisations = nscd_stats.size() > 8 ? (long long)nscd_stats[8] : 0;
   }
   try {
     sim.contact.restore_state(sim.model, contact);

@@ -20,6 +20,8 @@ void note_solver_runs(const NscdStats& end, const NscdStats& start) {
   g_record.unconverged_steps += end.unconverged_steps - start.unconverged_steps;
   g_record.iterations += end.iterations - start.iterations;
   g_record.cone_steps += end.cone_steps - start.cone_steps;
+  g_record.cone_products += end.cone_products - start.cone_products;
+  g_record.factorisations += end.factorisations - start.factorisations;
   // The run's largest values: those of the whole simulation, whose history before this run
   // (a copied settled state) is part of the command's record anyway.
   g_record.max_iterations = std::max(g_record.max_iterations, end.max_iterations);
@@ -30,8 +32,8 @@ void note_solver_runs(const NscdStats& end, const NscdStats& start) {
 namespace {
 
 nlohmann::json stats_json(const NscdStats& r) {
-  return {r.steps,          r.unconverged_steps, r.iterations,     r.cone_steps,
-          r.max_iterations, r.max_residual,      r.max_penetration};
+  return {r.steps,        r.unconverged_steps, r.iterations,    r.cone_steps,    r.max_iterations,
+          r.max_residual, r.max_penetration,   r.cone_products, r.factorisations};
 }
 
 NscdStats stats_of(const nlohmann::json& j) {
@@ -43,6 +45,8 @@ NscdStats stats_of(const nlohmann::json& j) {
   r.max_iterations = j.at(4);
   r.max_residual = j.at(5);
   r.max_penetration = j.at(6);
+  r.cone_products = j.at(7);
+  r.factorisations = j.at(8);
   return r;
 }
 
@@ -77,6 +81,8 @@ nlohmann::json solver_json(const Config& config, const NscdStats& r) {
           {"iterations_mean", r.steps > 0 ? double(r.iterations) / double(r.steps) : 0.0},
           {"iterations_max", r.max_iterations},
           {"cone_steps", r.cone_steps},
+          {"cone_products", r.cone_products},
+          {"factorisations", r.factorisations},
           {"unconverged_steps", r.unconverged_steps},
           {"unconverged_share", share},
           {"max_residual", r.max_residual},

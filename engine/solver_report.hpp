@@ -32,8 +32,9 @@ NscdStats solver_record();
 void reset_solver_record();
 
 // {"scheme": "nscd", "theta", "tolerance", "max_iterations", "steps", "iterations_mean",
-//  "iterations_max", "unconverged_steps", "unconverged_share", "max_residual",
-//  "max_interpenetration", "converged"}; {"scheme": "explicit"} for the explicit scheme.
+//  "iterations_max", "cone_steps", "cone_products", "factorisations", "unconverged_steps",
+//  "unconverged_share", "max_residual", "max_interpenetration", "converged"}; {"scheme":
+//  "explicit"} for the explicit scheme.
 nlohmann::json solver_json(const Config& config, const NscdStats& record);
 
 // Prints the warning on stderr when more than kUnconvergedShare of the steps stopped at the

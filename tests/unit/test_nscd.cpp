@@ -224,6 +224,8 @@ TEST(Nscd, RestartContinuesBitForBit) {
   EXPECT_EQ(second.model.rigid.omega, straight.model.rigid.omega);
   EXPECT_EQ(second.ledger.impact_dissipated, straight.ledger.impact_dissipated);
   EXPECT_EQ(second.nscd_stats.iterations, straight.nscd_stats.iterations);
+  EXPECT_EQ(second.nscd_stats.cone_products, straight.nscd_stats.cone_products);
+  EXPECT_EQ(second.nscd_stats.factorisations, straight.nscd_stats.factorisations);
   // The explicit scheme's checkpoint is not this one's.
   Simulation explicit_sim = deck_sim(deck, {"solver.scheme=\"explicit\""});
   EXPECT_NE(simulation_fingerprint(explicit_sim, 0.8), simulation_fingerprint(second, 0.8));
@@ -263,6 +265,10 @@ TEST(Nscd, AChainOfNinetyVoussoirsConvergesAndRestsOnItsWeight) {
   run_for(sim, 0.2);
   EXPECT_EQ(sim.nscd_stats.unconverged_steps, 0);
   EXPECT_GT(sim.nscd_stats.cone_steps, 0);
+  // The cone solve's work is counted: a product with W at least per cone solve, and the
+  // Newton steps on the face factor its matrix.
+  EXPECT_GE(sim.nscd_stats.cone_products, sim.nscd_stats.cone_steps);
+  EXPECT_GT(sim.nscd_stats.factorisations, 0);
   // Rest is rest (docs/nscd.md): a drift below 1e-6 of the span over 2 s, here over 0.2 s,
   // of the 2 m span.
   const double creep = 1e-6 * 2.0 * 0.2 / 2.0;
@@ -310,6 +316,11 @@ TEST(NscdProgram, TheArchsCapacityLiesBetweenTheExplicitSchemeAndLimitAnalysis) 
   EXPECT_EQ(s.at("converged"), true);  // at most kUnconvergedShare of the steps at the cap
   EXPECT_GE(s.at("iterations_max").get<int>(), 1);
   EXPECT_LT(s.at("max_interpenetration").get<double>(), 1e-4);
+  // The cone solve's work in the record: products with W whenever it ran.
+  const long long cone_steps = s.at("cone_steps"), products = s.at("cone_products");
+  EXPECT_GE(products, cone_steps);
+  EXPECT_EQ(products > 0, cone_steps > 0);
+  EXPECT_GE(s.at("factorisations").get<long long>(), 0);
   EXPECT_EQ(c.at("quasi_static"), false);
 }
 
