@@ -162,6 +162,26 @@ void piece_contact_points(const Vec2* p, int np, std::uint32_t p_outline, const 
   }
 }
 
+std::vector<double> NscdStats::numbers() const {
+  return {
+      double(steps),         double(unconverged_steps), double(iterations), double(max_iterations),
+      max_residual,          max_penetration,           double(cone_steps), double(cone_products),
+      double(factorisations)};
+}
+
+NscdStats NscdStats::from_numbers(const std::vector<double>& v) {
+  if (v.size() != 9 && v.size() != 7 && v.size() != 6)
+    throw std::invalid_argument("the non-smooth contact solver's record is not readable");
+  NscdStats st;
+  st.steps = (long long)v[0], st.unconverged_steps = (long long)v[1];
+  st.iterations = (long long)v[2], st.max_iterations = int(v[3]);
+  st.max_residual = v[4], st.max_penetration = v[5];
+  st.cone_steps = v.size() > 6 ? (long long)v[6] : 0;
+  st.cone_products = v.size() > 7 ? (long long)v[7] : 0;
+  st.factorisations = v.size() > 8 ? (long long)v[8] : 0;
+  return st;
+}
+
 void NscdStats::add(const NscdStepResult& r) {
   ++steps;
   iterations += r.iterations;

@@ -151,6 +151,12 @@ struct NscdStats {
   double max_residual = 0.0;        // largest final residual of a step
   double max_penetration = 0.0;     // largest overlap of a contact point seen [m]
   void add(const NscdStepResult& r);
+  // The record as numbers (checkpoints, the message of an MPI rank): steps, unconverged_steps,
+  // iterations, max_iterations, max_residual, max_penetration, cone_steps, cone_products,
+  // factorisations. from_numbers also reads the first 6 or 7 of them (older checkpoints; the
+  // rest 0) and throws std::invalid_argument on another count.
+  std::vector<double> numbers() const;
+  static NscdStats from_numbers(const std::vector<double>& v);
 };
 
 class NscdContact {

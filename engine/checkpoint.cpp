@@ -173,11 +173,7 @@ void write_checkpoint(const std::string& path, const Simulation& sim, std::uint6
   o.array(sim.contact.save_state());
   if (sim.scheme == StepScheme::RigidNscd) {  // the solver's record of the run so far (models of
                                               // that scheme only)
-    const NscdStats& st = sim.nscd_stats;
-    o.array(std::vector<double>{double(st.steps), double(st.unconverged_steps),
-                                double(st.iterations), double(st.max_iterations), st.max_residual,
-                                st.max_penetration, double(st.cone_steps), double(st.cone_products),
-                                double(st.factorisations)});
+    o.array(sim.nscd_stats.numbers());
   }
   o.array(driver_state);
   Fnv sum;
@@ -238,13 +234,13 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     for (auto& v : rigid) v = in.array<double>();
   const auto contact_kind = in.value<std::uint8_t>();
   const std::vector<char> contact = in.array<char>();
-  std::vector<double> nscd_stats;
+  NscdStats nscd_stats;
   if (sim.scheme == StepScheme::RigidNscd) {
-    nscd_stats = in.array<double>();
-    // 9 entries; 7 from a build that did not count the cone solve's work, 6 from one that had
-    // no cone solve
-    if (nscd_stats.size() != 9 && nscd_stats.size() != 7 && nscd_stats.size() != 6)
-      in.fail("the non-smooth contact solver's record is not readable");
+    try {
+      nscd_stats = NscdStats::from_numbers(in.array<double>());
+    } catch (const std::invalid_argument& e) {
+      in.fail(e.what());
+    }
   }
   std::vector<double> driver = in.array<double>();
   if (in.pos + sizeof(std::uint64_t) != buf.size()) in.fail("unexpected data after the state");
@@ -281,15 +277,7 @@ std::vector<double> read_checkpoint(const std::string& path, Simulation& sim,
     for (std::size_t b = 0; b < bodies; ++b)
       r.cx[b] = r.cx0[b] + r.ux[b], r.cy[b] = r.cy0[b] + r.uy[b];
   }
-  if (sim.scheme == StepScheme::RigidNscd) {
-    NscdStats& st = sim.nscd_stats;
-    st.steps = (long long)nscd_stats[0], st.unconverged_steps = (long long)nscd_stats[1];
-    st.iterations = (long long)nscd_stats[2], st.max_iterations = int(nscd_stats[3]);
-    st.max_residual = nscd_stats[4], st.max_penetration = nscd_stats[5];
-    st.cone_steps = nscd_stats.size() > 6 ? (long long)nscd_stats[6] : 0;
-    st.cone_products = nscd_stats.size() > 7 ? (long long)nscd_stats[7] : 0;
-    st.factorisations = nscd_stats.size() > 8 ? (long long)nscd_stats[8] : 0;
-  }
+  if (sim.scheme == StepScheme::RigidNscd) sim.nscd_stats = nscd_stats;
   try {
     sim.contact.restore_state(sim.model, contact);
   } catch (const std::exception& e) {

@@ -29,35 +29,13 @@ void note_solver_runs(const NscdStats& end, const NscdStats& start) {
   g_record.max_penetration = std::max(g_record.max_penetration, end.max_penetration);
 }
 
-namespace {
-
-nlohmann::json stats_json(const NscdStats& r) {
-  return {r.steps,        r.unconverged_steps, r.iterations,    r.cone_steps,    r.max_iterations,
-          r.max_residual, r.max_penetration,   r.cone_products, r.factorisations};
-}
-
-NscdStats stats_of(const nlohmann::json& j) {
-  NscdStats r;
-  r.steps = j.at(0);
-  r.unconverged_steps = j.at(1);
-  r.iterations = j.at(2);
-  r.cone_steps = j.at(3);
-  r.max_iterations = j.at(4);
-  r.max_residual = j.at(5);
-  r.max_penetration = j.at(6);
-  r.cone_products = j.at(7);
-  r.factorisations = j.at(8);
-  return r;
-}
-
-}  // namespace
-
 nlohmann::json solver_runs_since(const NscdStats& start) {
-  return {{"start", stats_json(start)}, {"end", stats_json(solver_record())}};
+  return {{"start", start.numbers()}, {"end", solver_record().numbers()}};
 }
 
 void note_solver_runs(const nlohmann::json& runs) {
-  note_solver_runs(stats_of(runs.at("end")), stats_of(runs.at("start")));
+  note_solver_runs(NscdStats::from_numbers(runs.at("end").get<std::vector<double>>()),
+                   NscdStats::from_numbers(runs.at("start").get<std::vector<double>>()));
 }
 
 NscdStats solver_record() {
