@@ -194,6 +194,18 @@ void NscdStats::add(const NscdStepResult& r) {
   max_penetration = std::max(max_penetration, r.penetration);
 }
 
+void NscdStats::add_run(const NscdStats& end, const NscdStats& start) {
+  steps += end.steps - start.steps;
+  unconverged_steps += end.unconverged_steps - start.unconverged_steps;
+  iterations += end.iterations - start.iterations;
+  cone_steps += end.cone_steps - start.cone_steps;
+  cone_products += end.cone_products - start.cone_products;
+  factorisations += end.factorisations - start.factorisations;
+  max_iterations = std::max(max_iterations, end.max_iterations);
+  max_residual = std::max(max_residual, end.max_residual);
+  max_penetration = std::max(max_penetration, end.max_penetration);
+}
+
 void NscdContact::setup(const Model& model, const RigidContact& rigid, double alert) {
   alert_ = alert;
   // An edge of a piece is an outline edge when its middle lies on the block's outline.

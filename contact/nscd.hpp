@@ -151,6 +151,9 @@ struct NscdStats {
   double max_residual = 0.0;        // largest final residual of a step
   double max_penetration = 0.0;     // largest overlap of a contact point seen [m]
   void add(const NscdStepResult& r);
+  // Adds what a run added to a record, from `start` to `end`: the counts' differences, and
+  // the largest values of `end` (a run's record includes the state it was copied from).
+  void add_run(const NscdStats& end, const NscdStats& start);
   // The record as numbers (checkpoints, the message of an MPI rank): steps, unconverged_steps,
   // iterations, max_iterations, max_residual, max_penetration, cone_steps, cone_products,
   // factorisations. from_numbers also reads the first 6 or 7 of them (older checkpoints; the

@@ -1,6 +1,5 @@
 #include "engine/solver_report.hpp"
 
-#include <algorithm>
 #include <cstdio>
 #include <mutex>
 
@@ -16,17 +15,9 @@ NscdStats g_record;
 void note_solver_runs(const NscdStats& end, const NscdStats& start) {
   if (end.steps == start.steps) return;
   const std::lock_guard<std::mutex> lock(g_mutex);
-  g_record.steps += end.steps - start.steps;
-  g_record.unconverged_steps += end.unconverged_steps - start.unconverged_steps;
-  g_record.iterations += end.iterations - start.iterations;
-  g_record.cone_steps += end.cone_steps - start.cone_steps;
-  g_record.cone_products += end.cone_products - start.cone_products;
-  g_record.factorisations += end.factorisations - start.factorisations;
-  // The run's largest values: those of the whole simulation, whose history before this run
-  // (a copied settled state) is part of the command's record anyway.
-  g_record.max_iterations = std::max(g_record.max_iterations, end.max_iterations);
-  g_record.max_residual = std::max(g_record.max_residual, end.max_residual);
-  g_record.max_penetration = std::max(g_record.max_penetration, end.max_penetration);
+  // The run's largest values are those of the whole simulation, whose history before this
+  // run (a copied settled state) is part of the command's record anyway.
+  g_record.add_run(end, start);
 }
 
 nlohmann::json solver_runs_since(const NscdStats& start) {
