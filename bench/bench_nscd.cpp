@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -43,7 +44,22 @@ using namespace voussoir;
 
 namespace {
 
-constexpr double kPga = 0.30;       // [g]
+// The deck, the record (its number in `synth --seed 1`) and its PGA [g]: church_b, 1, 0.30, or
+// BENCH_NSCD_DECK (a name in cases/), BENCH_NSCD_RECORD, BENCH_NSCD_PGA.
+struct Setting {
+  std::string deck = "church_b";
+  int record = 1;
+  double pga = 0.30;
+};
+Setting setting() {
+  Setting s;
+  if (const char* v = std::getenv("BENCH_NSCD_DECK")) s.deck = v;
+  if (const char* v = std::getenv("BENCH_NSCD_RECORD")) s.record = std::atoi(v);
+  if (const char* v = std::getenv("BENCH_NSCD_PGA")) s.pga = std::atof(v);
+  if (s.record < 1 || !(s.pga > 0.0))
+    throw std::invalid_argument("BENCH_NSCD_RECORD must be 1 or more, BENCH_NSCD_PGA positive");
+  return s;
+}
 constexpr double kFirstStop = 1.0;  // [s] of the record
 constexpr double kSpacing = 0.02;   // [s] between the states
 constexpr int kStates = 100;        // 1.00, 1.02, ... 2.98 s
@@ -56,16 +72,17 @@ struct Shaken {
   std::vector<Simulation> states;
 };
 
-BaseSignal first_record(double gravity) {
+BaseSignal shaking(const Setting& set, double gravity) {
   const SynthSettings settings;
   const Ec8Soil soil = *ec8_type1_soil('B');
   const std::vector<double> periods = synth_periods(settings);
   const SynthRecord r = synthesize_record(
-      settings, [&](double t) { return ec8_elastic_spectrum(t, 0.25, soil); }, periods, 1, 0);
+      settings, [&](double t) { return ec8_elastic_spectrum(t, 0.25, soil); }, periods, 1,
+      set.record - 1);
   Accelerogram record;
   for (std::size_t k = 0; k < r.accel.size(); ++k) {
     record.time.push_back(double(k) * settings.dt);
-    record.accel.push_back(r.accel[k] * kPga * gravity / r.pga);
+    record.accel.push_back(r.accel[k] * set.pga * gravity / r.pga);
   }
   return BaseSignal::table(record);
 }
@@ -73,10 +90,12 @@ BaseSignal first_record(double gravity) {
 // The states, prepared by this build, or read from (or written to) BENCH_NSCD_STATES.
 const Shaken& shaken() {
   static const Shaken s = [] {
-    const Config config = load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/church_b.toml",
-                                    {"solver.scheme=\"nscd\""});
+    const Setting set = setting();
+    const Config config =
+        load_deck(std::string(VOUSSOIR_SOURCE_DIR) + "/cases/" + set.deck + ".toml",
+                  {"solver.scheme=\"nscd\"", "material.model=\"rigid\""});
     const SettledState settled = settle(config, TrialCriteria{}, true);
-    Shaken out{first_record(settled.gravity), {}, {}};
+    Shaken out{shaking(set, settled.gravity), {}, {}};
     Simulation sim = settled.sim;
     out.loads.gravity = settled.gravity;
     out.loads.start = sim.ctx.time;
@@ -87,12 +106,15 @@ const Shaken& shaken() {
     auto path = [&](int k) {
       return (std::filesystem::path(dir) / ("state_" + std::to_string(k) + ".ckpt")).string();
     };
-    // The record's start is kept with the states: another build's settle can end at another time.
+    // Kept with the states: the record's start (another build's settle can end at another
+    // time), the record and its PGA.
     if (dir && std::filesystem::exists(path(kStates - 1))) {
       for (int k = 0; k < kStates; ++k) {
         out.states.push_back(sim);
-        const std::vector<double> start = read_checkpoint(path(k), out.states.back(), fingerprint);
-        out.loads.start = out.loads.signal_start = start.at(0);
+        const std::vector<double> kept = read_checkpoint(path(k), out.states.back(), fingerprint);
+        if (kept.size() != 3 || kept[1] != set.record || kept[2] != set.pga)
+          throw std::invalid_argument(path(k) + " holds the states of another record or PGA");
+        out.loads.start = out.loads.signal_start = kept[0];
       }
       return out;
     }
@@ -105,7 +127,7 @@ const Shaken& shaken() {
       out.states.push_back(sim);
       if (dir)
         write_checkpoint(path(k), sim, fingerprint, config.contact.friction,
-                         {out.loads.signal_start});
+                         {out.loads.signal_start, double(set.record), set.pga});
     }
     return out;
   }();
