@@ -6,8 +6,8 @@
 // the record. A benchmark times one step from a copy of each of fifty states (second 1: 1.00 to
 // 1.98 s; second 2: 2.00 to 2.98 s), on one thread. One step from many states, because the
 // solver's work is not a smooth function of its input: rounding the Tresca box differently
-// (a + (b - a) for b) tripled the median factorisations of the first second's steps, and
-// stepping on from a state soon compares two builds on different contacts.
+// (a + (b - a) for b) raised the median factorisations of the first second's steps from 7 to
+// 20, and stepping on from a state soon compares two builds on different contacts.
 //
 // The states depend on the solver that made them. To compare two builds on the same states,
 // set BENCH_NSCD_STATES=DIR: the first run writes the states there as checkpoints
