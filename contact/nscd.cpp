@@ -718,9 +718,9 @@ struct FaceScratch {
   // active-set steps of a box that does not settle alternate between a few faces. A new face
   // replaces the one used longest ago. A face's factors are the same numbers whether kept or
   // found again, so the results do not depend on kKeptFaces. On church_b under a record
-  // (bench/bench_nscd.cpp, the heavier second) 16 faces instead of 1 take 10% fewer
-  // factorisations a step (48.2 to 43.3) and 8.5% fewer instructions in the solver; 8 faces
-  // 7.5%, 32 faces the same as 16.
+  // (bench/bench_nscd.cpp, the heavier second) 16 faces instead of 1 take 43.3 factorisations
+  // a step instead of 48.2 and 8.5% fewer instructions in the solver; 8 faces 44.6 and 5.9%;
+  // 32 faces 43.0.
   std::array<FaceFactors, kKeptFaces> kept;
   FaceFactors* current = nullptr;  // the factors face_step solves with
   long long clock = 0;
