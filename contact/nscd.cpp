@@ -710,8 +710,7 @@ struct FaceScratch {
   FaceMatrix a;                                  // the face's matrix (A masked to the face)
   std::vector<double> values;                    // A's values, a's positions
   Eigen::VectorXd rhs, x;
-  bool analysed = false;         // the structure above is that of `key`
-  long long structure = 0;       // counts the structures found, so that factors know theirs
+  long long structure = 0;       // the structures found (0: none yet), for factors to know theirs
   long long factorisations = 0;  // on this thread, for the solver's record
   // The factors of the last faces met in this cone solve. A face met again reuses its
   // factors: a later pass of Tresca's box keeps the face more often than not, and the
@@ -724,6 +723,7 @@ struct FaceScratch {
   std::array<FaceFactors, kKeptFaces> kept;
   FaceFactors* current = nullptr;  // the factors face_step solves with
   long long clock = 0;
+  std::vector<char> face;  // face_step's face, kept to spare an allocation a step
 };
 thread_local FaceScratch t_face;
 
@@ -755,10 +755,9 @@ void NscdContact::assemble_cone_matrix(const std::vector<double>& inv,
     const long long b = inv[3 * std::size_t(c.b)] == 0.0 ? -1 : c.b;
     key[k] = ((a + 1) << 32) | (b + 1);
   }
-  const bool same = w.analysed && key == w.key && w.body_start.size() == nb + 1;
+  const bool same = w.structure > 0 && key == w.key && w.body_start.size() == nb + 1;
   if (!same) {
     w.key.swap(key);
-    w.analysed = true;
     ++w.structure;
     w.body_start.assign(nb + 1, 0);
     for_each_entry(points_, inv, [&](std::size_t, std::size_t, bool, std::size_t body) {
@@ -870,7 +869,8 @@ bool NscdContact::face_step(const std::vector<double>& s, const std::vector<char
   FaceScratch& w = t_face;
   const Eigen::Index m = Eigen::Index(2 * points_.size());
   std::fill(d.begin(), d.end(), 0.0);
-  std::vector<char> face(static_cast<std::size_t>(m));
+  std::vector<char>& face = w.face;
+  face.resize(static_cast<std::size_t>(m));
   for (std::size_t i = 0; i < face.size(); ++i) face[i] = char(free[i] && s[i] > 0.0);
   auto on_face = [&](Eigen::Index i) { return face[std::size_t(i)] != 0; };
   if (w.current == nullptr || w.current->face != face) {
