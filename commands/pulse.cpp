@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "commands/common.hpp"
 #include "core/fnv.hpp"
@@ -121,7 +123,8 @@ std::vector<ControlPoint> find_control_points(const Model& model) {
 PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, double lambda,
                       const std::vector<ControlPoint>& points, const PulseCriteria& crit,
                       const PulseRecorder& recorder, double record_every,
-                      const std::function<void(const Simulation&)>& at_end) {
+                      const std::function<void(const Simulation&)>& at_end,
+                      const std::atomic<bool>* cancel) {
   const auto wall0 = Clock::now();
   Simulation sim = settled.sim;     // deep copy
   fit_step_to_signal(sim, signal);  // nscd: no step longer than a record's sampling interval
@@ -220,6 +223,7 @@ PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, dou
   spec.rules.push_back(std::make_unique<TrendRule>(d_fall, crit.fall_rotation, duration, duration,
                                                    duration + crit.free_time));
   spec.on_step = [&](Simulation& s, const StepInfo&) {
+    if (cancel && cancel->load(std::memory_order_relaxed)) throw RunError("run cancelled");
     r.max_kinetic_energy = std::max(r.max_kinetic_energy, s.ledger.kinetic);
     if ((s.step - step0) % rec_every != 0) return;
     sync_rigid_nodes(s.model);
@@ -355,10 +359,25 @@ bool same_search(const nlohmann::json& run, double frequency, const SearchKey& k
   return true;
 }
 
+namespace {
+// One run of a search: the signal of `base` at `frequency` scaled to a peak of `a` g.
+PulseResult search_run(const SettledState& settled, const BaseConfig& base, double frequency,
+                       double a, const std::vector<ControlPoint>& points, const PulseCriteria& crit,
+                       const std::atomic<bool>* cancel) {
+  const BaseSignal signal = make_base_signal(base, a, frequency, settled.gravity);
+  PulseResult r = run_pulse(settled, signal, 0.0, points, crit, nullptr, 1e-3, nullptr, cancel);
+  r.amplitude_g = a;
+  r.frequency = frequency;
+  r.control.clear();  // not needed per trial
+  return r;
+}
+}  // namespace
+
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
                                    double frequency, const AmplitudeSearchOptions& search,
                                    const PulseCriteria& crit, bool quiet, Journal* journal,
-                                   const SearchKey& key) {
+                                   const SearchKey& key, RunsAhead<PulseResult>* ahead,
+                                   std::size_t ahead_search) {
   const auto wall0 = Clock::now();
   CurvePoint cp;
   cp.frequency = frequency;
@@ -375,15 +394,22 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
       }
     return found;
   };
-  auto trial = [&](double a) {
+  // The run of `a`; `next`: the amplitudes the search will most likely ask for after it, best
+  // first, for a board of runs ahead (those in the journal left out).
+  auto trial = [&](double a, std::vector<double> next) {
     PulseResult r;
     const bool resumed = journal && from_journal(a, r);
     if (!resumed) {
-      const BaseSignal signal = make_base_signal(base, a, frequency, settled.gravity);
-      r = run_pulse(settled, signal, 0.0, points, crit);
-      r.amplitude_g = a;
-      r.frequency = frequency;
-      r.control.clear();  // not needed per trial
+      if (ahead) {
+        PulseResult unused;
+        if (journal)
+          next.erase(std::remove_if(next.begin(), next.end(),
+                                    [&](double x) { return from_journal(x, unused); }),
+                     next.end());
+        r = ahead->take(ahead_search, a, std::move(next));
+      } else {
+        r = search_run(settled, base, frequency, a, points, crit, nullptr);
+      }
       if (journal) {
         nlohmann::json record = pulse_run_record(r);
         record.update(key.fields);
@@ -407,14 +433,39 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
   // Bracket: up from the start by `growth` until a collapse, or down until a survival.
   const bool stepping = search.search == AmplitudeSearch::Step;
   const double growth = stepping ? 1.0 + search.step : kBracketGrowth;
+  // What the search asks for next (the plans of the runs ahead; they change no result). The
+  // stepping search's steps above a first collapse at `collapse`, as it runs them below.
+  auto steps_above = [&](double collapse) {
+    std::vector<double> out;
+    for (int k = 0; stepping && k < search.steps_above && collapse * growth <= kMaxAmplitude; ++k)
+      out.push_back(collapse *= growth);
+    return out;
+  };
+  // The bisection's probe in `c`, unless `c` is narrow enough (shrink_bracket's test).
+  auto probe_in = [&](const Bracket& c, std::vector<double>& out) {
+    if (c.hi - c.lo > search.tolerance * c.hi)
+      out.push_back(bracket_probes(c, 1, ProbePlacement::Midpoint)[0]);
+  };
+  // Stepping up from `a` (survived at `lo`, when `lo` > 0): the next step (also the first step
+  // above `a` should it collapse) and the one after, then the bisection below `a`.
+  auto after_step_up = [&](double a, double lo) {
+    std::vector<double> next;
+    if (a * growth <= kMaxAmplitude) next.push_back(a * growth);
+    if (a * growth * growth <= kMaxAmplitude) next.push_back(a * growth * growth);
+    if (lo > 0.0) probe_in(Bracket{lo, a}, next);
+    return next;
+  };
   double lo = 0.0, hi = 0.0;
   bool have_hi = false, have_lo = false;
   double a = search.start;
-  if (trial(a)) {
+  if (trial(a, after_step_up(a, 0.0))) {
     hi = a, have_hi = true;
     while (!have_lo && a > kMinAmplitude) {
       a /= growth;
-      if (trial(a)) {
+      std::vector<double> next;
+      if (a > kMinAmplitude) next.push_back(a / growth);
+      probe_in(Bracket{a, hi}, next);
+      if (trial(a, next)) {
         hi = a;
       } else {
         lo = a, have_lo = true;
@@ -424,7 +475,7 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     lo = a, have_lo = true;
     while (!have_hi && a * growth <= kMaxAmplitude) {
       a *= growth;
-      if (trial(a)) {
+      if (trial(a, after_step_up(a, lo))) {
         hi = a, have_hi = true;
       } else {
         lo = a;
@@ -442,7 +493,13 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
     shrink_bracket(
         b, search.tolerance, 1, ProbePlacement::Midpoint,
         [&](const std::vector<double>& amplitudes) {
-          return std::vector<bool>{trial(amplitudes[0])};
+          // Next: the steps above (sure to come), then the probe below this one (more often a
+          // survival: the longer run), then the probe above it.
+          const double m = amplitudes[0];
+          std::vector<double> next = steps_above(first_collapse);
+          probe_in(Bracket{b.lo, m}, next);
+          probe_in(Bracket{m, b.hi}, next);
+          return std::vector<bool>{trial(m, next)};
         },
         [](const Bracket&) {});
     lo = b.lo;
@@ -450,11 +507,9 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
   }
   // Stepping: the steps above the first collapse (non-monotone check; A_c stays hi).
   if (stepping && have_hi && have_lo) {
-    double above = first_collapse;
-    for (int k = 0; k < search.steps_above && above * growth <= kMaxAmplitude; ++k) {
-      above *= growth;
-      trial(above);
-    }
+    const std::vector<double> above = steps_above(first_collapse);
+    for (std::size_t k = 0; k < above.size(); ++k)
+      trial(above[k], std::vector<double>(above.begin() + k + 1, above.end()));
   }
   cp.lo = lo;
   cp.hi = have_hi ? hi : lo;
@@ -523,8 +578,18 @@ std::vector<SearchOutcome> deal_searches(
   CellWork work;
   work.cells = cells.size();
   if (spread) work.input = [&](std::size_t k) { return runs_of(cells[order[k]]); };
+  // In one process, threads with no search left run the searches' next runs ahead.
+  const std::vector<ControlPoint> points = find_control_points(settled.sim.model);
+  std::optional<RunsAhead<PulseResult>> ahead;
+  if (rank_count() == 1 && (threads > 0 ? threads : omp_get_max_threads()) > 1) {
+    ahead.emplace(cells.size(), [&](std::size_t i, double a, const std::atomic<bool>& cancel) {
+      return search_run(settled, cells[i].base, cells[i].frequency, a, points, crit, &cancel);
+    });
+    work.idle = [&] { ahead->help(); };
+  }
   work.run = [&](std::size_t k, const nlohmann::json& given) {
-    const SearchCell& cell = cells[order[k]];
+    const std::size_t i = order[k];
+    const SearchCell& cell = cells[i];
     Journal share(given.is_array() ? given.get<std::vector<nlohmann::json>>()
                                    : std::vector<nlohmann::json>());
     CurvePoint p;
@@ -532,11 +597,13 @@ std::vector<SearchOutcome> deal_searches(
     try {
       // Under mpirun the progress is a line per search, printed by rank 0 as it arrives.
       p = find_collapse_amplitude(settled, cell.base, cell.frequency, cell.search, crit,
-                                  quiet || rank_count() > 1, spread ? &share : journal, cell.key);
+                                  quiet || rank_count() > 1, spread ? &share : journal, cell.key,
+                                  ahead ? &*ahead : nullptr, i);
     } catch (const std::exception& e) {
       error = e.what();
       p.frequency = cell.frequency;
     }
+    if (ahead) ahead->done(i);
     nlohmann::json record = curve_point_record(p);
     record["error"] = error;
     return record;
@@ -560,6 +627,14 @@ std::vector<SearchOutcome> deal_searches(
     if (done) done(i, out);
   };
   deal_cells(work, threads, quiet);
+  if (ahead && !quiet) {
+    const AheadStats st = ahead->stats();
+    if (st.started > 0)
+      std::fprintf(stderr,
+                   "runs ahead on idle threads: %d, %d of them used (%d cancelled, %.1f s of "
+                   "wall on runs not used)\n",
+                   st.started, st.used, st.cancelled, st.unused_s);
+  }
   if (!is_dealer_rank()) return {};
   return outcomes;
 }

@@ -60,6 +60,8 @@
 // dynamic schedule), each from a copy of one settled state; the result for a frequency does
 // not depend on the thread count.
 
+#include <atomic>
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
@@ -68,6 +70,7 @@
 #include "commands/capacity.hpp"
 #include "commands/common.hpp"
 #include "engine/journal.hpp"
+#include "engine/runs_ahead.hpp"
 #include "seismic/base_motion.hpp"
 
 namespace voussoir {
@@ -150,11 +153,14 @@ struct PulseResult {
 
 // One pulse run from a copy of `settled`. `recorder` (optional) is called every
 // `record_every` seconds of signal time (and at the start and the end); `at_end` (optional)
-// once with the final state (pulse --picture).
+// once with the final state (pulse --picture). `cancel` (optional): when it becomes true the run
+// stops at its next step with a RunError (a run ahead that its search no longer wants,
+// engine/runs_ahead.hpp).
 PulseResult run_pulse(const SettledState& settled, const BaseSignal& signal, double lambda,
                       const std::vector<ControlPoint>& points, const PulseCriteria& criteria,
                       const PulseRecorder& recorder = nullptr, double record_every = 1e-3,
-                      const std::function<void(const Simulation&)>& at_end = nullptr);
+                      const std::function<void(const Simulation&)>& at_end = nullptr,
+                      const std::atomic<bool>* cancel = nullptr);
 
 struct CurvePoint {
   double frequency = 0.0;     // [Hz]
@@ -207,11 +213,14 @@ bool same_search(const nlohmann::json& run, double frequency, const SearchKey& k
 // (engine/journal.hpp; `pulse --curve --resume FILE`), a run of the same search (same_search)
 // and amplitude found there is taken from it instead of being run (the searches recompute the
 // same amplitudes bit for bit), and every run is appended as it finishes; safe to share between
-// the searches run in parallel.
+// the searches run in parallel. With `ahead` (deal_searches), the search is `ahead_search` of
+// that board: it runs through it and plans its next amplitudes there (engine/runs_ahead.hpp).
 CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig& base,
                                    double frequency, const AmplitudeSearchOptions& search,
                                    const PulseCriteria& criteria, bool quiet,
-                                   Journal* journal = nullptr, const SearchKey& key = {});
+                                   Journal* journal = nullptr, const SearchKey& key = {},
+                                   RunsAhead<PulseResult>* ahead = nullptr,
+                                   std::size_t ahead_search = 0);
 
 // The tilting capacity lambda* that a study of base motions starts its searches from (and
 // compares them with): `given` when it is >= 0 (--lambda-star), otherwise `voussoir capacity`'s
@@ -243,11 +252,12 @@ struct SearchOutcome {
 
 // Runs the searches `cells`, taken in the order `order` (the costliest first, for the dynamic
 // schedule; the order changes no result), dealt to `threads` threads per rank and to the ranks
-// of an MPI run (engine/dealer.hpp), from copies of `settled`. With a `journal` (rank 0's;
-// null: none) every run is journalled: in one process as it finishes; under mpirun a search
-// takes its runs already journalled with it, and rank 0 journals its new runs when the search
-// comes back. Returns on rank 0 the outcome of each cell (by cell index), `done` being told of
-// each as it arrives (progress); an empty vector on the other ranks.
+// of an MPI run (engine/dealer.hpp), from copies of `settled`. In one process, threads with no
+// search left run the others' next runs ahead (engine/runs_ahead.hpp; no result changes). With a
+// `journal` (rank 0's; null: none) every run is journalled: in one process as it finishes; under
+// mpirun a search takes its runs already journalled with it, and rank 0 journals its new runs when
+// the search comes back. Returns on rank 0 the outcome of each cell (by cell index), `done` being
+// told of each as it arrives (progress); an empty vector on the other ranks.
 std::vector<SearchOutcome> deal_searches(
     const SettledState& settled, const std::vector<SearchCell>& cells,
     const std::vector<std::size_t>& order, const PulseCriteria& criteria, int threads, bool quiet,

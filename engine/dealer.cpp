@@ -20,6 +20,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -58,30 +59,35 @@ bool is_finished(const CellWork& w, std::size_t c) {
   return c < w.finished.size() && w.finished[c];
 }
 
-// One process: an OpenMP loop over the cells.
+// One process: the threads take the cells in order, one at a time (a dynamic schedule), then
+// help the cells still running (CellWork::idle).
 void deal_here(const CellWork& w, int threads) {
   const long n = static_cast<long>(w.cells);
-  const int nthreads = static_cast<int>(
-      std::max(1L, std::min(n, long(threads > 0 ? threads : omp_get_max_threads()))));
+  const long asked = threads > 0 ? threads : omp_get_max_threads();
+  const int nthreads = static_cast<int>(std::max(1L, w.idle ? asked : std::min(n, asked)));
   std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads)
-  for (long c = 0; c < n; ++c) {
-    // After a stop request (engine/stop.hpp) no cell starts, and a cell cut short is not taken:
-    // its record would journal the interruption as the cell's result.
-    if (is_finished(w, c) || stop_requested()) continue;
-    nlohmann::json input;
-    if (w.input) {
+  std::atomic<long> next{0};
+#pragma omp parallel num_threads(nthreads)
+  {
+    for (long c = next++; c < n; c = next++) {
+      // After a stop request (engine/stop.hpp) no cell starts, and a cell cut short is not
+      // taken: its record would journal the interruption as the cell's result.
+      if (is_finished(w, c) || stop_requested()) continue;
+      nlohmann::json input;
+      if (w.input) {
 #pragma omp critical(voussoir_deal)
-      input = w.input(c);
-    }
-    const nlohmann::json record = w.run(c, input);
-    if (stop_requested()) continue;
+        input = w.input(c);
+      }
+      const nlohmann::json record = w.run(c, input);
+      if (stop_requested()) continue;
 #pragma omp critical(voussoir_deal)
-    try {
-      w.take(c, record);
-    } catch (...) {
-      if (!failure) failure = std::current_exception();
+      try {
+        w.take(c, record);
+      } catch (...) {
+        if (!failure) failure = std::current_exception();
+      }
     }
+    if (w.idle) w.idle();
   }
   if (failure) std::rethrow_exception(failure);
   throw_if_stopped();

@@ -61,6 +61,11 @@ struct CellWork {
   std::function<nlohmann::json(std::size_t, const nlohmann::json& input)> run;
   // Rank 0: a finished cell's record, one at a time, in the order the cells finish.
   std::function<void(std::size_t, const nlohmann::json& record)> take;
+  // One process (optional): a thread with no cell left to start helps the cells still running
+  // (`pulse --curve` and `ida` run their searches' next runs ahead, engine/runs_ahead.hpp) and
+  // returns when there is nothing left to help with. Must not throw. With it every thread
+  // starts, even when there are fewer cells than threads.
+  std::function<void()> idle;
 };
 
 // Runs every cell not finished (header comment) on `threads` OpenMP threads per rank (0: the

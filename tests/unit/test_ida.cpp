@@ -341,7 +341,8 @@ IdaRun run_ida(const std::string& name, const std::vector<std::string>& records,
 // survived, its upper end collapsed, both among the runs), the IM is the record's PGA, and the
 // fragility is fitted. Sa(T) as the IM: the same runs (the search is in PGA), every intensity
 // multiplied by the record's Sa(T) / PGA, checked against the spectrum of the file computed
-// here. Two threads give the same CSV as one (wall times aside); --resume runs nothing again.
+// here. Two threads give the same CSV as one (wall times aside), also for one record, whose
+// search the second thread runs ahead; --resume runs nothing again.
 TEST(Ida, SlenderBlockUnderThreeRecords) {
   const std::vector<std::string> records = {write_record(0), write_record(1), write_record(2)};
   const IdaRun pga = run_ida("pga", records, {"--threads", "1", "-q"});
@@ -422,6 +423,14 @@ TEST(Ida, SlenderBlockUnderThreeRecords) {
   ASSERT_TRUE(two.process.exited && two.process.status == 0) << two.process.err;
   EXPECT_EQ(without_wall(two.csv), without_wall(pga.csv));
   EXPECT_EQ(without_wall(two.runs_csv), without_wall(pga.runs_csv));
+  // One record on two threads: the second thread has no search from the start and runs the
+  // search's next runs ahead (engine/runs_ahead.hpp); the runs are those of one thread.
+  const IdaRun lone = run_ida("lone", {records[1]}, {"--threads", "1", "-q"});
+  const IdaRun lone_two = run_ida("lone_two", {records[1]}, {"--threads", "2", "-q"});
+  ASSERT_TRUE(lone.process.exited && lone.process.status == 0) << lone.process.err;
+  ASSERT_TRUE(lone_two.process.exited && lone_two.process.status == 0) << lone_two.process.err;
+  EXPECT_EQ(without_wall(lone_two.runs_csv), without_wall(lone.runs_csv));
+  EXPECT_GT(text_of(lone.runs_csv).size(), 0u);
 
   const std::string journal = (temp_dir() / "ida.journal").string();
   const IdaRun first = run_ida("first", records, {"--threads", "2", "--resume", journal});
