@@ -535,11 +535,25 @@ std::optional<TiltingCapacity> study_capacity(const Config& config, const TrialC
   std::exception_ptr failure;
   if (is_dealer_rank()) try {
       if (!quiet) std::fprintf(stderr, "tilting capacity lambda* (voussoir capacity)...\n");
+      // lambda* is a quasi-static limit: a trial is stable when it comes to rest, and under
+      // nscd a contact solve stopped at a loose tolerance lets a stable structure creep
+      // (church_b at 1e-4: trials at 0.0993 and 0.0981 neither rested nor fell within their 3
+      // s, lambda* 0.0979 against 0.10407). So the search runs at the default tolerance when
+      // the study's is looser; the study's runs keep theirs.
+      Config capacity_config = config;
+      const double converged = SolverConfig{}.tolerance;
+      if (config.solver.scheme == "nscd" && config.solver.tolerance > converged) {
+        capacity_config.solver.tolerance = converged;
+        if (!quiet)
+          std::fprintf(stderr, "  at solver.tolerance = %s (the default; the runs use %s)\n",
+                       option_number(converged).c_str(),
+                       option_number(config.solver.tolerance).c_str());
+      }
       CapacitySearch capacity_search;
       capacity_search.points = points;
       capacity_search.quiet = quiet;
       if (!resume.empty()) capacity_search.journal = resume + ".capacity";
-      const CapacityResult cap = find_capacity(config, settle, capacity_search);
+      const CapacityResult cap = find_capacity(capacity_config, settle, capacity_search);
       // Without a collapse there is no tilting capacity, hence no quasi-static limit to start
       // the searches from or to compare them with.
       if (!cap.bracketed) {

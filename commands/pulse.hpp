@@ -226,9 +226,10 @@ CurvePoint find_collapse_amplitude(const SettledState& settled, const BaseConfig
 // compares them with): `given` when it is >= 0 (--lambda-star), otherwise `voussoir capacity`'s
 // search (commands/capacity.hpp, `points` trials a round, journalled in `resume` + ".capacity"
 // when `resume` is not empty), run on rank 0 alone, its result shared with the other ranks.
-// Rank 0 rethrows a failure, and a search without a collapse is one (RunError: no quasi-static
-// limit; --lambda-star gives one); the other ranks then get nothing and stop without a word
-// (rank 0 reports it).
+// Under nscd the search runs at solver.tolerance's default when the study's is looser (a loose
+// contact solve lets a stable trial creep instead of coming to rest). Rank 0 rethrows a failure,
+// and a search without a collapse is one (RunError: no quasi-static limit; --lambda-star gives
+// one); the other ranks then get nothing and stop without a word (rank 0 reports it).
 struct TiltingCapacity {
   double lambda_star = 0.0;
   double wall_s = 0.0;  // of the search (0 when given)
