@@ -4,15 +4,16 @@
 //
 // A study deals its searches (a curve's frequencies, an IDA's records) to threads, one search a
 // thread, and a search makes its runs one after the other. Once fewer searches are left than
-// threads, the threads without one would idle while the last searches go on (church B's IDA
-// by nscd, docs/ida.md: its last record's search alone for minutes; 1231 s of wall on 2 threads
-// without the runs ahead, 1156 s with them). So each search, as it asks for a run, tells the
-// board the amplitudes it will most likely ask for next, best first (its plan); a thread with
-// no search left takes the first planned amplitude, of the searches in the order they made
-// their first plan, that is neither run nor running, and runs it. A search that asks
-// for an amplitude run ahead takes the result, or waits for the run still going; a run ahead
-// that has dropped out of its search's plan (the search went the other way) is cancelled: its
-// runner sees `cancel` set and stops early (with an exception or any result, discarded).
+// threads, the threads without one would idle while the last searches go on (church B's IDA by
+// nscd, docs/ida.md: its last record's search alone for minutes). So each search, as it asks for a
+// run, tells the board the amplitudes it will most likely ask for next, best first (its plan); a
+// thread with no search left takes the first planned amplitude, of the searches in the order they
+// made their first plan, that is neither run nor running, and runs it. A search that asks for an
+// amplitude run ahead takes the result; while that run still goes on, the search's own thread runs
+// the next planned amplitude meanwhile (so both keep working down the plan, not one waiting for the
+// other's run). A run ahead that has dropped out of its search's plan (the search went the other
+// way) is cancelled: its runner sees `cancel` set and stops early (with an exception or any result,
+// discarded).
 //
 // What the searches see does not change: a run's result is a function of its search and
 // amplitude alone (each run starts from a copy of the same settled state; results do not
@@ -56,7 +57,8 @@ class RunsAhead {
   RunsAhead(std::size_t searches, Runner run) : run_(std::move(run)), left_(searches) {}
 
   // The run of `a` for search `search`, which plans `next` after it (best first): the run ahead
-  // of `a` if one was started (waiting for it), else run here.
+  // of `a` if one was started (running planned amplitudes here until it has ended), else run
+  // here.
   Result take(std::size_t search, double a, std::vector<double> next) {
     std::unique_lock<std::mutex> lock(mutex_);
     const Key key{search, a};
@@ -67,7 +69,15 @@ class RunsAhead {
     set_plan(search, std::move(next));
     changed_.notify_all();
     if (ahead) {
-      changed_.wait(lock, [&] { return entries_.at(key).done; });
+      // While that run goes on, this thread runs the next planned amplitude rather than wait
+      // (else the search would always wait for the run it planned last, one core working).
+      while (!entries_.at(key).done) {
+        Key other;
+        if (pick(other))
+          run_ahead(lock, other);
+        else
+          changed_.wait(lock);
+      }
       Entry e = std::move(entries_.at(key));
       entries_.erase(key);
       ++stats_.used;
@@ -107,33 +117,7 @@ class RunsAhead {
         changed_.wait_for(lock, std::chrono::milliseconds(200));
         continue;
       }
-      Entry& e = entries_[key];
-      ++stats_.started;
-      const std::shared_ptr<std::atomic<bool>> cancel = e.cancel;
-      lock.unlock();
-      const auto t0 = std::chrono::steady_clock::now();
-      Result result{};
-      std::exception_ptr error;
-      try {
-        result = run_(key.first, key.second, *cancel);
-      } catch (...) {
-        error = std::current_exception();
-      }
-      const double wall =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      lock.lock();
-      if (cancel->load()) {
-        ++stats_.cancelled;
-        stats_.unused_s += wall;
-        entries_.erase(key);
-      } else {
-        Entry& ended = entries_.at(key);
-        ended.done = true;
-        ended.result = std::move(result);
-        ended.error = error;
-        ended.wall_s = wall;
-      }
-      changed_.notify_all();
+      run_ahead(lock, key);
     }
   }
 
@@ -152,6 +136,38 @@ class RunsAhead {
     double wall_s = 0.0;
     std::shared_ptr<std::atomic<bool>> cancel = std::make_shared<std::atomic<bool>>(false);
   };
+
+  // Under the lock, released while it runs: runs `key` ahead and keeps its result (dropped
+  // when it was cancelled meanwhile).
+  void run_ahead(std::unique_lock<std::mutex>& lock, const Key& key) {
+    Entry& e = entries_[key];
+    ++stats_.started;
+    const std::shared_ptr<std::atomic<bool>> cancel = e.cancel;
+    lock.unlock();
+    const auto t0 = std::chrono::steady_clock::now();
+    Result result{};
+    std::exception_ptr error;
+    try {
+      result = run_(key.first, key.second, *cancel);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    lock.lock();
+    if (cancel->load()) {
+      ++stats_.cancelled;
+      stats_.unused_s += wall;
+      entries_.erase(key);
+    } else {
+      Entry& ended = entries_.at(key);
+      ended.done = true;
+      ended.result = std::move(result);
+      ended.error = error;
+      ended.wall_s = wall;
+    }
+    changed_.notify_all();
+  }
 
   // Under the lock: the search's new plan; its runs ahead not asked for and out of it cancelled.
   void set_plan(std::size_t search, std::vector<double> next) {

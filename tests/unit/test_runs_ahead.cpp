@@ -75,6 +75,34 @@ TEST(RunsAhead, ARunDroppedFromThePlanIsCancelled) {
   expect_stats(board.stats(), 1, 0, 1);
 }
 
+// While the run ahead it asks for goes on, the search's thread runs the next planned amplitude:
+// the helper's run of 2 cannot end before 3 has started, and only the search's thread is free
+// to start it.
+TEST(RunsAhead, ASearchWaitingForARunAheadRunsTheNextPlannedOne) {
+  std::atomic<bool> two{false}, three{false};
+  const std::thread::id main_thread = std::this_thread::get_id();
+  RunsAhead<FakeRun> board(1, [&](std::size_t s, double a, const std::atomic<bool>&) {
+    if (a == 2.0) {
+      two = true;
+      while (!three.load()) std::this_thread::yield();
+    }
+    if (a == 3.0) three = true;
+    if (a == 1.0)
+      while (!two.load()) std::this_thread::yield();
+    return FakeRun{s, a, std::this_thread::get_id() != main_thread};
+  });
+  std::thread helper([&] { board.help(); });
+  board.take(0, 1.0, {2.0});
+  const FakeRun second = board.take(0, 2.0, {3.0});
+  const FakeRun third = board.take(0, 3.0, {});
+  board.done(0);
+  helper.join();
+  EXPECT_TRUE(second.ahead);
+  EXPECT_EQ(third.amplitude, 3.0);
+  EXPECT_FALSE(third.ahead);
+  expect_stats(board.stats(), 2, 2, 0);
+}
+
 // A run ahead that throws throws again in the search that asks for it.
 TEST(RunsAhead, ARunAheadThatFailedFailsWhenAskedFor) {
   std::atomic<bool> started{false};
