@@ -22,6 +22,7 @@
 // for bit; only wall times depend on what ran ahead. (engine/trial_pool.hpp does the same for
 // the rounds of one capacity search.)
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -174,9 +175,7 @@ class RunsAhead {
     if (plans_.find(search) == plans_.end()) order_.push_back(search);
     for (auto& [key, e] : entries_) {
       if (key.first != search || e.done || e.asked) continue;
-      bool planned = false;
-      for (double a : next) planned = planned || a == key.second;
-      if (!planned) e.cancel->store(true);
+      if (std::find(next.begin(), next.end(), key.second) == next.end()) e.cancel->store(true);
     }
     plans_[search] = std::move(next);
   }

@@ -1,12 +1,12 @@
 // The board of runs ahead (engine/runs_ahead.hpp): a run started ahead is what its search then
-// takes, a run dropped from its search's plan is cancelled, a run ahead that failed fails when
-// asked for, and an ended search frees the helper. The runners wait for one another, so what
+// takes, a run dropped from its search's plan is cancelled, a search waiting for a run ahead
+// runs the next planned one, a run ahead that failed fails when asked for, runs are kept apart
+// by search, and an ended search frees the helper. The runners wait for one another, so what
 // runs ahead is certain, not a matter of timing.
 
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <stdexcept>
 #include <thread>
 #include <vector>
 
