@@ -308,6 +308,47 @@ inline void local_velocity(const ContactPoint& c, const double* v, double rax, d
   ut = -dx * c.n.y + dy * c.n.x;
 }
 
+// MPRGP's split of the gradient g at y in the box [lo, hi]: the free gradient phi (zero at a
+// bound), the chopped gradient beta (the part of g at a bound that points out of the box) and
+// weight |phi + beta| in `weighted`. Here and below the arrays do not overlap, so that the
+// compiler does several components at a time (about 7% of a heavy step of church_b).
+void split_gradient(std::size_t m, const double* __restrict y, const double* __restrict lo,
+                    const double* __restrict hi, const double* __restrict g,
+                    const double* __restrict weight, double* __restrict phi,
+                    double* __restrict beta, double* __restrict weighted) {
+  for (std::size_t i = 0; i < m; ++i) {
+    const bool at_lo = y[i] <= lo[i], at_hi = y[i] >= hi[i];
+    const double low = std::min(g[i], 0.0), high = std::max(g[i], 0.0);
+    const double phi_i = at_lo | at_hi ? 0.0 : g[i];
+    const double out_lo = at_hi ? 0.0 : low, out_hi = at_lo ? 0.0 : high;
+    const double beta_i = at_lo ? out_lo : at_hi ? out_hi : 0.0;
+    phi[i] = phi_i, beta[i] = beta_i;
+    weighted[i] = weight[i] * std::abs(phi_i + beta_i);
+  }
+}
+
+// For each component, how far y can go along -dir before it meets a bound (infinity where dir
+// is 0). Every division is taken, so that the compiler does several at a time.
+void step_to_bounds(std::size_t m, const double* __restrict y, const double* __restrict lo,
+                    const double* __restrict hi, const double* __restrict dir,
+                    double* __restrict step) {
+  for (std::size_t i = 0; i < m; ++i) {
+    const double q = (dir[i] > 0.0 ? y[i] - lo[i] : y[i] - hi[i]) / dir[i];
+    step[i] = dir[i] != 0.0 ? q : std::numeric_limits<double>::infinity();
+  }
+}
+
+// MPRGP's reduced free gradient: phi, cut where a step of alpha_bar along -phi would pass a
+// bound (its components where phi is 0 are not used).
+void reduced_free_gradient(std::size_t m, const double* __restrict y, const double* __restrict lo,
+                           const double* __restrict hi, const double* __restrict phi,
+                           double alpha_bar, double* __restrict reduced) {
+  for (std::size_t i = 0; i < m; ++i) {
+    const double q = (phi[i] > 0.0 ? y[i] - lo[i] : y[i] - hi[i]) / alpha_bar;
+    reduced[i] = phi[i] > 0.0 ? std::min(q, phi[i]) : std::max(q, phi[i]);
+  }
+}
+
 // Modified proportioning with reduced gradient projections (MPRGP: Dostal, "Optimal quadratic
 // programming algorithms", Springer 2009, ch. 7 and 8) for min f(y) = y.A y / 2 - b.y over the
 // box lo <= y <= hi, A symmetric positive semi-definite with unit diagonal, applied by
@@ -331,7 +372,7 @@ int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vecto
            const std::vector<double>& weight, double tol, const StepLength& step_length,
            int max_products, std::vector<double>& y, bool& converged) {
   const std::size_t m = y.size();
-  std::vector<double> g(m), p(m), ap(m), phi(m), beta(m), d(m), y_try(m), g_try(m);
+  std::vector<double> g(m), p(m), ap(m), phi(m), beta(m), d(m), y_try(m), g_try(m), scratch(m);
   std::vector<char> free(m);
   int products = 0, last_newton = -kNewtonEvery;
   auto gradient_at = [&](const std::vector<double>& x, std::vector<double>& out) {
@@ -348,25 +389,17 @@ int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vecto
   // The free gradient phi and the chopped gradient beta; returns the largest weighted
   // component of the projected gradient phi + beta.
   auto split = [&]() {
+    split_gradient(m, y.data(), lo.data(), hi.data(), g.data(), weight.data(), phi.data(),
+                   beta.data(), scratch.data());
     double worst = 0.0;
-    for (std::size_t i = 0; i < m; ++i) {
-      const bool at_lo = y[i] <= lo[i], at_hi = y[i] >= hi[i];
-      phi[i] = at_lo || at_hi ? 0.0 : g[i];
-      beta[i] = at_lo && at_hi ? 0.0
-                : at_lo        ? std::min(g[i], 0.0)
-                : at_hi        ? std::max(g[i], 0.0)
-                               : 0.0;
-      worst = std::max(worst, weight[i] * std::abs(phi[i] + beta[i]));
-    }
+    for (std::size_t i = 0; i < m; ++i) worst = std::max(worst, scratch[i]);
     return worst;
   };
   // The longest step along -dir that stays in the box.
   auto feasible_step = [&](const std::vector<double>& dir) {
+    step_to_bounds(m, y.data(), lo.data(), hi.data(), dir.data(), scratch.data());
     double a = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < m; ++i) {
-      if (dir[i] > 0.0) a = std::min(a, (y[i] - lo[i]) / dir[i]);
-      if (dir[i] < 0.0) a = std::min(a, (y[i] - hi[i]) / dir[i]);
-    }
+    for (std::size_t i = 0; i < m; ++i) a = std::min(a, scratch[i]);
     return a;
   };
   for (std::size_t i = 0; i < m; ++i) y[i] = std::clamp(y[i], lo[i], hi[i]);
@@ -429,13 +462,12 @@ int box_qp(const Apply& apply_a, const FaceNewton& face_newton, const std::vecto
       }
     }
     const double alpha_bar = step_length();
+    reduced_free_gradient(m, y.data(), lo.data(), hi.data(), phi.data(), alpha_bar,
+                          scratch.data());
     double beta2 = 0.0, phi_reduced = 0.0;
     for (std::size_t i = 0; i < m; ++i) {
       beta2 += beta[i] * beta[i];
-      if (phi[i] == 0.0) continue;
-      const double reduced = phi[i] > 0.0 ? std::min((y[i] - lo[i]) / alpha_bar, phi[i])
-                                          : std::max((y[i] - hi[i]) / alpha_bar, phi[i]);
-      phi_reduced += reduced * phi[i];
+      if (phi[i] != 0.0) phi_reduced += scratch[i] * phi[i];
     }
     if (beta2 <= phi_reduced) {
       apply_a(p, ap);
