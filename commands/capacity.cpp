@@ -576,6 +576,7 @@ int command_capacity(const Config& config, const CommonOptions& common,
     if (ext != ".gif" && ext != ".mp4")
       throw DeckError("--movie " + opts.movie + ": the movie must end in .gif or .mp4");
   }
+  warn_loose_tolerance(config, "capacity", common.quiet);
   TrialCriteria criteria = opts.criteria;
   criteria.limits = common.limits;
   criteria.quasi_static = !opts.dynamic;

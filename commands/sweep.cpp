@@ -4,6 +4,7 @@
 #include "commands/sweep.hpp"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -129,6 +130,10 @@ int command_sweep(const std::string& deck_path, const std::vector<std::string>& 
   // Every cell's deck validated up front, so a bad value stops the sweep before any work.
   const Grid grid = make_grid(deck_path, sets, axes);
   for (const Config& c : grid.configs) require_gravity(c, "sweep");
+  const auto loosest = std::max_element(
+      grid.configs.begin(), grid.configs.end(),
+      [](const Config& a, const Config& b) { return a.solver.tolerance < b.solver.tolerance; });
+  warn_loose_tolerance(*loosest, "sweep", common.quiet || !is_dealer_rank());
   const size_t cells = grid.configs.size();
   const std::vector<std::vector<std::string>>& cell_values = grid.values;
   const std::vector<Config>& configs = grid.configs;

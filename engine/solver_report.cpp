@@ -74,4 +74,16 @@ bool warn_unconverged(const Config& config, const NscdStats& r, bool quiet) {
   return true;
 }
 
+bool warn_loose_tolerance(const Config& config, const char* command, bool quiet) {
+  const double converged = SolverConfig{}.tolerance;
+  if (config.solver.scheme != "nscd" || !(config.solver.tolerance > converged)) return false;
+  if (!quiet)
+    std::fprintf(stderr,
+                 "warning: %s: solver.tolerance = %g is looser than the default %g: a stable "
+                 "structure can creep at it, and a trial that neither comes to rest nor falls "
+                 "counts as a collapse, so lambda* can come out low\n",
+                 command, config.solver.tolerance, converged);
+  return true;
+}
+
 }  // namespace voussoir

@@ -638,7 +638,8 @@ const std::vector<KeySpec>& key_table() {
       {"solver.tolerance", [](auto& c) { return &c.solver.tolerance; },
        Number{above(0), "x the step's velocity scale"},
        "nscd: the Gauss-Seidel stops when a sweep changes no body's velocity by more than this "
-       "times h |a| or the fastest approach (docs/nscd.md)"},
+       "times h |a| or the fastest approach; above the default a stable structure can creep, "
+       "which `capacity` and `sweep` warn of (docs/nscd.md)"},
       {"solver.max_iterations", [](auto& c) { return &c.solver.max_iterations; },
        Integer{1, 100000000},
        "nscd: most Gauss-Seidel sweeps a step (a step that reaches it is counted unconverged)"},
