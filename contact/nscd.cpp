@@ -42,7 +42,9 @@ constexpr std::size_t kKeptFaces = 16;
 // impulses one or two usually solve the box, and a pass of Tresca's box that keeps the face
 // reuses its factors. A step is kept even when it raises f (the best iterate is returned to
 // MPRGP): refusing such steps, as MPRGP's own Newton steps do, sent a quarter of the boxes to
-// MPRGP and took 2.4 times the products on church_b under a record.
+// MPRGP and took 2.4 times the products on church_b under a record. Bertsekas' projected Newton
+// steps (an epsilon-active set, an Armijo search along the projection arc) in their place took
+// 4 to 28% more factorisations and 8 to 23% more time there (8, 20 or 40 steps before MPRGP).
 constexpr int kActiveSetSteps = 8;
 // Power iterations for the largest eigenvalue of W (the projections' step), and its margin
 // (power iterations approach it from below).
