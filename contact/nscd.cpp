@@ -35,7 +35,8 @@ constexpr int kConeProducts = 3000;
 // the factorisations on church_b (bench/bench_nscd.cpp). Starting the passes from the solution
 // of the associated cone (in 2D a box in (mu r_n + r_t) / 2 and (mu r_n - r_t) / 2, solved by
 // MPRGP alone to 1000 products) halved the passes' factorisations on church_b's heavier second
-// (25.3 to 13.9 a step) but cost 960 products a step: it wants a face solve of its own.
+// (25.3 to 13.9 a step) but cost 960 products a step; solved with its own face's Newton steps
+// it took as many factorisations in all (25.1 to 27.3) and 6 to 7% more time.
 constexpr int kTrescaPasses = 16;
 constexpr int kNewtonEvery = 10;
 constexpr double kFaceRegularisation = 1e-6;
