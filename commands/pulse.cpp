@@ -542,7 +542,7 @@ std::optional<TiltingCapacity> study_capacity(const Config& config, const TrialC
       // the study's is looser; the study's runs keep theirs.
       Config capacity_config = config;
       const double converged = SolverConfig{}.tolerance;
-      if (config.solver.scheme == "nscd" && config.solver.tolerance > converged) {
+      if (tolerance_too_loose_for_rest(config)) {
         capacity_config.solver.tolerance = converged;
         if (!quiet)
           std::fprintf(stderr, "  at solver.tolerance = %s (the default; the runs use %s)\n",

@@ -74,9 +74,13 @@ bool warn_unconverged(const Config& config, const NscdStats& r, bool quiet) {
   return true;
 }
 
+bool tolerance_too_loose_for_rest(const Config& config) {
+  return config.solver.scheme == "nscd" && config.solver.tolerance > SolverConfig{}.tolerance;
+}
+
 bool warn_loose_tolerance(const Config& config, const char* command, bool quiet) {
+  if (!tolerance_too_loose_for_rest(config)) return false;
   const double converged = SolverConfig{}.tolerance;
-  if (config.solver.scheme != "nscd" || !(config.solver.tolerance > converged)) return false;
   if (!quiet)
     std::fprintf(stderr,
                  "warning: %s: solver.tolerance = %g is looser than the default %g: a stable "

@@ -43,8 +43,10 @@ bool warn_unconverged(const Config& config, const NscdStats& record, bool quiet)
 
 // Under nscd a solver.tolerance above the default lets a stable structure creep, and a
 // capacity trial that neither comes to rest nor falls counts as a collapse, so lambda* can come
-// out low (docs/nscd.md, "Capacity, sweeps, maps and pulses"). Prints a warning on stderr for
-// the capacity searches of `command` (unless quiet); true when the tolerance is looser.
+// out low (docs/nscd.md, "Capacity, sweeps, maps and pulses"). True when `config` is so.
+bool tolerance_too_loose_for_rest(const Config& config);
+// Prints a warning on stderr for the capacity searches of `command` when it is (unless quiet);
+// true when the tolerance is looser.
 bool warn_loose_tolerance(const Config& config, const char* command, bool quiet);
 
 }  // namespace voussoir
